@@ -1,0 +1,24 @@
+"""htetro-opt: path and coverage planning for the hinged-Tetromino (hTetro) reconfigurable robot."""
+
+from htetro_opt.errors import (
+    ConfigurationError,
+    HtetroError,
+    MapFormatError,
+    PlanningError,
+    ScenarioError,
+    UnknownCommandError,
+    UnknownShapeError,
+)
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "__version__",
+    "HtetroError",
+    "ScenarioError",
+    "MapFormatError",
+    "ConfigurationError",
+    "UnknownShapeError",
+    "UnknownCommandError",
+    "PlanningError",
+]

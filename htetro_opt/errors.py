@@ -1,0 +1,52 @@
+"""The exception hierarchy of htetro-opt.
+
+Every error the library raises on bad input derives from :class:`HtetroError`, so that callers (and
+the CLI) can catch one type. Each subclass also derives from the closest built-in exception, so code
+written against ``ValueError`` or ``KeyError`` keeps working.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "HtetroError",
+    "ScenarioError",
+    "MapFormatError",
+    "ConfigurationError",
+    "UnknownShapeError",
+    "UnknownCommandError",
+    "PlanningError",
+]
+
+
+class HtetroError(Exception):
+    """Base class of every error raised by htetro-opt on bad input or an impossible request."""
+
+
+class ScenarioError(HtetroError, ValueError):
+    """A scenario file or map cannot be read: malformed TOML/YAML, missing or mistyped keys."""
+
+
+class MapFormatError(ScenarioError):
+    """A grid or image map is malformed: ragged rows, unknown characters, a bad PGM header."""
+
+
+class ConfigurationError(HtetroError, ValueError):
+    """A robot configuration is impossible: outside the map, colliding, or not a legal pose."""
+
+
+class UnknownShapeError(HtetroError, KeyError):
+    """A morphology name is not one of the robot's shapes."""
+
+    def __str__(self) -> str:  # KeyError quotes its message; keep it readable
+        return str(self.args[0]) if self.args else ""
+
+
+class UnknownCommandError(HtetroError, KeyError):
+    """A motion-command token is not in the command vocabulary of shared/MODEL.md §3."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if self.args else ""
+
+
+class PlanningError(HtetroError, RuntimeError):
+    """A planner was asked something it cannot do (e.g. an empty roadmap)."""

@@ -1,0 +1,28 @@
+"""The one hTetro robot model shared by every method (shared/MODEL.md): geometry, commands, sweeps,
+workspaces and the batch simulator. It imports nothing else of htetro_opt but its errors."""
+
+from htetro_opt.model.commands import (
+    COMMANDS,
+    DIAGONAL_COMMANDS,
+    SEED000_COMMANDS,
+    SEED004_COMMANDS,
+    TOKENS,
+    Command,
+    Timing,
+    command_id,
+    command_set,
+    format_commands,
+    parse_commands,
+)
+from htetro_opt.model.robot import FOOTPRINTS, N_NAMED, N_STATES, SHAPES, STATE_NAMES, Pose, block_poses, shape_index
+from htetro_opt.model.simulate import SimulationResult, Simulator, simulate
+from htetro_opt.model.sweeps import SweepTables, sweep_tables
+from htetro_opt.model.workspace import MovingObstacle, Workspace, grid_distance
+
+__all__ = [
+    "COMMANDS", "DIAGONAL_COMMANDS", "SEED000_COMMANDS", "SEED004_COMMANDS", "TOKENS", "Command", "Timing",
+    "command_id", "command_set", "format_commands", "parse_commands",
+    "FOOTPRINTS", "N_NAMED", "N_STATES", "SHAPES", "STATE_NAMES", "Pose", "block_poses", "shape_index",
+    "SimulationResult", "Simulator", "simulate", "SweepTables", "sweep_tables",
+    "MovingObstacle", "Workspace", "grid_distance",
+]

@@ -1,0 +1,394 @@
+"""Batch simulation of motion-command sequences by table lookup (the hot path of every GA).
+
+A :class:`Simulator` compiles, once per workspace, command set, timing and clearance, a transition
+table ``next[pose, command]``: poses are the flat ids ``((state * 4 + heading) * H + y) * W + x``,
+``next`` holds the pose after the command or ``dead`` where the command's swept cells are not all
+inside the map and free, and an extra ``pad`` command leaves every pose unchanged. Simulating a batch
+is then one gather per step for the whole batch. Moving obstacles add, per time step, a sorted array
+of blocked ``pose * n_columns + command`` keys (the swept-cell table turned inside out), checked with
+one ``searchsorted`` per step.
+
+Time for moving obstacles is the number of commands executed (MODEL.md §5): command number t (from 0,
+counted from ``t0``) must keep its swept cells clear of every cell a moving obstacle covers between
+times t and t + 1.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from htetro_opt.errors import ConfigurationError, UnknownCommandError
+from htetro_opt.model.commands import (
+    COMMANDS,
+    N_COMMANDS,
+    TOKENS,
+    Timing,
+    command_id,
+    command_set,
+    parse_commands,
+)
+from htetro_opt.model.robot import N_HEADINGS, N_NAMED, N_STATES, STATE_NAMES, Pose, shape_index
+from htetro_opt.model.sweeps import SweepTables, sweep_tables
+from htetro_opt.model.workspace import Workspace
+
+__all__ = ["Simulator", "SimulationResult", "simulate"]
+
+_STOP = command_id("stop")
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """Outcome of simulating a batch of command sequences.
+
+    Attributes
+    ----------
+    valid : ndarray of bool, shape (B,)
+        No command of the run part was invalid.
+    first_invalid : ndarray of int, shape (B,)
+        Index of the first invalid command, −1 if none.
+    executed : ndarray of int, shape (B,)
+        Commands executed: those before the first invalid one (and, with ``stop_at_goal``, up to
+        reaching the goal).
+    reached : ndarray of bool, shape (B,)
+        The executed prefix passes through the roadmap's configurations in order and ends on the last.
+    progress : ndarray of int, shape (B,)
+        Number of roadmap configurations passed (the start counts as the first).
+    time : ndarray of float, shape (B,)
+        Total duration of the executed commands.
+    final : ndarray of int, shape (B, 4)
+        Final (x, y, state, heading).
+    trace : ndarray of int, shape (B, L + 1)
+        Pose ids after each command; entries past ``executed`` are meaningless.
+    """
+
+    valid: np.ndarray
+    first_invalid: np.ndarray
+    executed: np.ndarray
+    reached: np.ndarray
+    progress: np.ndarray
+    time: np.ndarray
+    final: np.ndarray
+    trace: np.ndarray
+    simulator: "Simulator"
+
+    def __len__(self) -> int:
+        return len(self.valid)
+
+    def poses(self, i: int) -> np.ndarray:
+        """Poses visited by sequence i, start included: shape (executed + 1, 4) of (x, y, state, heading)."""
+        return self.simulator.decode(self.trace[i, : self.executed[i] + 1])
+
+    def final_pose(self, i: int) -> Pose:
+        x, y, s, h = (int(v) for v in self.final[i])
+        return Pose(x, y, STATE_NAMES[s], h)
+
+
+class Simulator:
+    """Compiled transition tables of one workspace for one command set.
+
+    Parameters
+    ----------
+    workspace : Workspace
+    commands : iterable of str or int, optional, keyword-only
+        Command tokens or ids the sequences may use; seed 000's set by default (plus the diagonals
+        when ``diagonals``). Seed 004's block commands bring in the 16 intermediate states.
+    diagonals : bool, keyword-only
+        Add the four diagonal translations to the default set.
+    timing : Timing, keyword-only
+    clearance : float, keyword-only
+        δ in cells (MODEL.md §4).
+
+    Examples
+    --------
+    >>> sim = Simulator(Workspace(np.zeros((6, 6), dtype=bool)))
+    >>> result = sim.run([parse_commands("x+,x+,y+")], Pose(1, 2, "O", 0))
+    >>> result.final_pose(0), float(result.time[0])
+    (Pose(x=3, y=3, shape='O', heading=0), 3.0)
+    """
+
+    def __init__(
+        self,
+        workspace: Workspace,
+        *,
+        commands: Iterable[str | int] | None = None,
+        diagonals: bool = False,
+        timing: Timing | None = None,
+        clearance: float = 0.0,
+    ) -> None:
+        if not isinstance(workspace, Workspace):
+            raise TypeError(f"workspace must be a Workspace, got {type(workspace).__name__}")
+        if commands is None:
+            ids = command_set(diagonals=diagonals)
+        else:
+            listed = list(commands)
+            ids = tuple(int(c) for c in (parse_commands(listed) if listed and isinstance(listed[0], str) else listed))
+            if any(not 0 <= c < N_COMMANDS for c in ids) or len(set(ids)) != len(ids):
+                raise ValueError(f"invalid command set {listed!r}")
+        self.workspace = workspace
+        self.timing = timing if timing is not None else Timing()
+        self.tables: SweepTables = sweep_tables(float(clearance))
+        self.command_ids = np.array(ids, dtype=np.int64)
+        self.n_commands = len(ids)
+        self.pad = self.n_commands
+        self.n_columns = self.n_commands + 1
+        uses_blocks = any(COMMANDS[c].kind == "block" and any(COMMANDS[c].hinge_delta) for c in ids)
+        self.n_states = N_STATES if uses_blocks else N_NAMED
+        self.n_poses = self.n_states * N_HEADINGS * workspace.height * workspace.width
+        self.dead = self.n_poses
+        self.local = np.full(N_COMMANDS, -1, dtype=np.int64)
+        self.local[self.command_ids] = np.arange(self.n_commands)
+        self.durations = np.append(self.timing.durations()[self.command_ids], 0.0)
+        self.next = self._transition_table()
+        self._blocked: dict[int, np.ndarray] = {}
+
+    # --- compilation -------------------------------------------------------------------------
+    def _valid_table(self, free: np.ndarray) -> np.ndarray:
+        """valid[state, heading, command, y, x] for a free-cell map (True = free)."""
+        t = self.tables
+        offsets = t.offsets[: self.n_states, :, self.command_ids]  # (S, 4, C, K, 2)
+        pad = int(np.abs(offsets).max()) + 1
+        h, w = free.shape
+        padded = np.zeros((h + 2 * pad, w + 2 * pad), dtype=bool)
+        padded[pad : pad + h, pad : pad + w] = free
+        distinct, inverse = np.unique(offsets.reshape(-1, 2), axis=0, return_inverse=True)
+        shifted = np.stack([padded[pad + oy : pad + oy + h, pad + ox : pad + ox + w] for ox, oy in distinct])
+        which = inverse.reshape(offsets.shape[:-1])
+        valid = shifted[which[..., 0]]
+        for k in range(1, which.shape[-1]):
+            valid &= shifted[which[..., k]]
+        legal = t.legal[: self.n_states, self.command_ids]
+        valid &= legal[:, None, :, None, None]
+        return valid
+
+    def _transition_table(self) -> np.ndarray:
+        t, ws = self.tables, self.workspace
+        h, w, S, C = ws.height, ws.width, self.n_states, self.n_commands
+        valid = self._valid_table(~ws.occupancy)
+        target_state = t.next_state[:S][:, self.command_ids].clip(0)  # (S, C)
+        target_heading = t.next_heading[:S][:, :, self.command_ids]  # (S, 4, C)
+        dx, dy = t.shift[self.command_ids, 0], t.shift[self.command_ids, 1]
+        ys, xs = np.arange(h)[:, None, None], np.arange(w)[None, :, None]
+        # pose id of the target, laid out (S, 4, H, W, C); out-of-map targets are masked by `valid`.
+        base = (target_state[:, None, :] * N_HEADINGS + target_heading)[:, :, None, None, :]
+        target = (base * h + (ys + dy)) * w + (xs + dx)
+        ok = valid.transpose(0, 1, 3, 4, 2)
+        table = np.empty((self.n_poses + 1, self.n_columns), dtype=np.int64)
+        table[:-1, :C] = np.where(ok, target, self.dead).reshape(-1, C)
+        table[:-1, C] = np.arange(self.n_poses)
+        table[-1] = self.dead
+        dtype = np.int32 if self.n_poses < 2**31 - 1 else np.int64
+        return table.astype(dtype)
+
+    @cached_property
+    def _flat_next(self) -> np.ndarray:
+        return self.next.ravel()
+
+    @cached_property
+    def _sweep_entries(self) -> np.ndarray:
+        """Rows (state, heading, local command, ox, oy) of every swept cell of every legal entry."""
+        t = self.tables
+        rows = []
+        for s in range(self.n_states):
+            for h in range(N_HEADINGS):
+                for ci, g in enumerate(self.command_ids):
+                    if t.legal[s, g]:
+                        cells = t.cells(s, h, g)
+                        rows.append(np.column_stack([np.tile([s, h, ci], (len(cells), 1)), cells]))
+        return np.concatenate(rows)
+
+    def blocked_keys(self, t: int) -> np.ndarray:
+        """Sorted keys ``pose * n_columns + command`` that a moving obstacle blocks at step t → t + 1."""
+        ws = self.workspace
+        phase = t % ws.period
+        if phase not in self._blocked:
+            cells = np.argwhere(ws.moving_during(phase))[:, ::-1]  # (x, y)
+            e = self._sweep_entries
+            px = cells[:, None, 0] - e[None, :, 3]
+            py = cells[:, None, 1] - e[None, :, 4]
+            inside = (px >= 0) & (px < ws.width) & (py >= 0) & (py < ws.height)
+            pose = ((e[None, :, 0] * N_HEADINGS + e[None, :, 1]) * ws.height + py) * ws.width + px
+            keys = pose * self.n_columns + e[None, :, 2]
+            self._blocked[phase] = np.unique(keys[inside])
+        return self._blocked[phase]
+
+    # --- poses -------------------------------------------------------------------------------
+    def encode(self, pose: Pose) -> int:
+        """Flat pose id of a pose.
+
+        Raises
+        ------
+        ConfigurationError
+            If the pose is outside the map or its state is not used by this simulator.
+        """
+        pose = Pose.of(*pose)
+        s = shape_index(pose.shape)
+        if s >= self.n_states:
+            raise ConfigurationError(f"state {pose.shape!r} needs seed 004's block commands")
+        if not self.workspace.contains(pose.x, pose.y):
+            raise ConfigurationError(
+                f"pose ({pose.x}, {pose.y}) lies outside the {self.workspace.width} x {self.workspace.height} map"
+            )
+        ws = self.workspace
+        return int(((s * N_HEADINGS + pose.heading) * ws.height + pose.y) * ws.width + pose.x)
+
+    def decode(self, ids) -> np.ndarray:
+        """(x, y, state, heading) of flat pose ids, shape (..., 4)."""
+        ids = np.asarray(ids, dtype=np.int64)
+        ws = self.workspace
+        x = ids % ws.width
+        y = (ids // ws.width) % ws.height
+        sh = ids // (ws.width * ws.height)
+        return np.stack([x, y, sh // N_HEADINGS, sh % N_HEADINGS], axis=-1)
+
+    def pose_free(self, pose_id: int, t: int | None = None) -> bool:
+        """Whether a pose's footprint (with clearance) is inside the map and free (at time t)."""
+        x, y, s, h = (int(v) for v in self.decode(pose_id))
+        cells = self.tables.cells(s, h, _STOP) + (x, y)
+        occ = self.workspace.occupancy if t is None else self.workspace.occupancy_at(t)
+        inside = (cells[:, 0] >= 0) & (cells[:, 0] < self.workspace.width) & (cells[:, 1] >= 0) & (cells[:, 1] < self.workspace.height)
+        return bool(inside.all() and not occ[cells[:, 1], cells[:, 0]].any())
+
+    def check_pose(self, pose: Pose, *, what: str = "pose", t: int | None = None) -> int:
+        """Encode a pose and check it is collision-free; its flat id.
+
+        Raises
+        ------
+        ConfigurationError
+            Naming ``what`` (e.g. "start") if the pose lies outside the map or collides.
+        """
+        try:
+            pid = self.encode(pose)
+        except ConfigurationError as err:
+            raise ConfigurationError(f"{what} {tuple(pose)}: {err}") from err
+        if not self.pose_free(pid, t):
+            raise ConfigurationError(
+                f"{what} {tuple(pose)} collides with an obstacle or leaves the map"
+                + ("" if t is None else f" at time {t}")
+            )
+        return pid
+
+    # --- simulation --------------------------------------------------------------------------
+    def _local_commands(self, sequences: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        lengths = np.fromiter((len(s) for s in sequences), dtype=np.int64, count=len(sequences))
+        width = int(lengths.max()) if len(lengths) else 0
+        local = np.full((len(sequences), width), self.pad, dtype=np.int64)
+        for i, seq in enumerate(sequences):
+            local[i, : lengths[i]] = seq
+        if local.size:
+            ids = local[local != self.pad]
+            bad = (ids < 0) | (ids >= N_COMMANDS)
+            if bad.any():
+                raise UnknownCommandError(f"command id {int(ids[bad][0])} is not a command")
+            mapped = self.local[ids]
+            if (mapped < 0).any():
+                token = TOKENS[int(ids[mapped < 0][0])]
+                raise UnknownCommandError(f"command {token!r} is not in this simulator's command set")
+            local[local != self.pad] = mapped
+        return local, lengths
+
+    def run(
+        self,
+        sequences: Sequence[Sequence[int]] | np.ndarray,
+        start: Pose | int,
+        *,
+        roadmap: Sequence[Pose] | None = None,
+        t0: int = 0,
+        stop_at_goal: bool = False,
+    ) -> SimulationResult:
+        """Simulate a batch of command sequences from one start pose.
+
+        Parameters
+        ----------
+        sequences : sequence of int arrays
+            Global command ids (see :func:`parse_commands`), of any lengths; a 2-D array is a batch of
+            equal-length sequences.
+        start : Pose or int
+            Start pose (or its flat id).
+        roadmap : sequence of Pose, optional, keyword-only
+            Configurations to pass through in order after the start; the last is the goal.
+        t0 : int, keyword-only
+            Time index (commands already executed) at the start, for moving obstacles.
+        stop_at_goal : bool, keyword-only
+            End each sequence when it reaches the goal (seed 000's child termination).
+
+        Returns
+        -------
+        SimulationResult
+
+        Raises
+        ------
+        ConfigurationError
+            If the start pose collides or a roadmap pose lies outside the map.
+        UnknownCommandError
+            If a sequence uses a command outside this simulator's set.
+        """
+        start_id = start if isinstance(start, (int, np.integer)) else self.check_pose(start, what="start", t=t0)
+        goals = np.array([self.encode(p) for p in roadmap], dtype=np.int64) if roadmap else np.empty(0, np.int64)
+        local, lengths = self._local_commands(list(sequences))
+        batch, width = local.shape
+        trace = np.empty((batch, width + 1), dtype=np.int64)
+        pose = np.full(batch, start_id, dtype=np.int64)
+        trace[:, 0] = pose
+        flat, columns, dead = self._flat_next, self.n_columns, self.dead
+        moving = bool(self.workspace.moving)
+        for t in range(width):
+            keys = pose * columns + local[:, t]
+            pose = flat[keys].astype(np.int64)
+            if moving:
+                blocked = self.blocked_keys(t0 + t)
+                if len(blocked):
+                    at = np.searchsorted(blocked, keys).clip(max=len(blocked) - 1)
+                    pose[blocked[at] == keys] = dead
+            trace[:, t + 1] = pose
+        return self._summarise(trace, local, lengths, goals, stop_at_goal)
+
+    def _summarise(self, trace, local, lengths, goals, stop_at_goal) -> SimulationResult:
+        batch, width = local.shape
+        steps = np.arange(width + 1)
+        # Roadmap progress: the first step at or after the previous hit where the next pose is met.
+        progress = np.ones(batch, dtype=np.int64)
+        when = np.zeros(batch, dtype=np.int64)
+        for k, goal in enumerate(goals, start=1):
+            hit = (trace == goal) & (steps[None, :] >= when[:, None]) & (progress == k)[:, None]
+            found = hit.any(axis=1)
+            progress[found] += 1
+            when[found] = hit.argmax(axis=1)[found]
+        run_length = lengths.copy()
+        done = progress == len(goals) + 1
+        if stop_at_goal and len(goals):
+            run_length[done] = np.minimum(run_length[done], when[done])
+        dead_step = (trace[:, 1:] == self.dead) & (steps[None, 1:] <= run_length[:, None])
+        first_invalid = np.full(batch, -1, dtype=np.int64)
+        if width:
+            first_invalid = np.where(dead_step.any(axis=1), dead_step.argmax(axis=1), -1)
+        executed = np.where(first_invalid >= 0, first_invalid, run_length)
+        final_ids = trace[np.arange(batch), executed]
+        reached = done & (final_ids == goals[-1]) if len(goals) else np.zeros(batch, dtype=bool)
+        ran = steps[None, 1:] <= executed[:, None]
+        time = np.where(ran, self.durations[local], 0.0).sum(axis=1)
+        return SimulationResult(
+            valid=first_invalid < 0,
+            first_invalid=first_invalid,
+            executed=executed,
+            reached=reached,
+            progress=progress,
+            time=time,
+            final=self.decode(final_ids),
+            trace=trace,
+            simulator=self,
+        )
+
+
+def simulate(workspace: Workspace, sequences, start: Pose, **options) -> SimulationResult:
+    """Compile a :class:`Simulator` for ``workspace`` and run ``sequences`` from ``start``.
+
+    Keyword options are split between :class:`Simulator` (commands, diagonals, timing, clearance)
+    and :meth:`Simulator.run` (roadmap, t0, stop_at_goal).
+    """
+    compile_keys = {"commands", "diagonals", "timing", "clearance"}
+    sim = Simulator(workspace, **{k: v for k, v in options.items() if k in compile_keys})
+    return sim.run(sequences, start, **{k: v for k, v in options.items() if k not in compile_keys})

@@ -1,0 +1,226 @@
+"""Grid workspaces, moving obstacles and grid distances (shared/MODEL.md §1, §5).
+
+Cell ``(x, y)`` has x growing to the right and y upwards; occupancy is ``occ[y, x]`` with True for an
+obstacle, and every cell outside the map counts as an obstacle. Moving obstacles advance along their
+route by ``speed`` cells per command executed (time index t = number of commands executed so far).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from htetro_opt.errors import ConfigurationError, ScenarioError
+
+__all__ = ["Workspace", "MovingObstacle", "grid_distance"]
+
+
+@dataclass(frozen=True)
+class MovingObstacle:
+    """A rigid group of cells patrolling a route.
+
+    Parameters
+    ----------
+    cells : ndarray of int, shape (n, 2)
+        (x, y) cells the obstacle covers at t = 0.
+    route : ndarray of int, shape (m, 2)
+        Waypoints of the obstacle's displacement from ``cells``; the first is (0, 0). Between two
+        waypoints the obstacle moves one cell per unit step along each axis that still differs (so
+        diagonal segments are allowed).
+    speed : int
+        Unit steps taken per command executed.
+    mode : {"pingpong", "loop"}
+        Patrol back and forth along the route, or return from its last waypoint to its first.
+    """
+
+    cells: np.ndarray
+    route: np.ndarray
+    speed: int = 1
+    mode: str = "pingpong"
+    _steps: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        cells = np.asarray(self.cells, dtype=np.int64).reshape(-1, 2)
+        route = np.asarray(self.route, dtype=np.int64).reshape(-1, 2)
+        if len(cells) == 0:
+            raise ScenarioError("a moving obstacle needs at least one cell")
+        if len(route) == 0 or route[0].any():
+            route = np.vstack([np.zeros((1, 2), dtype=np.int64), route])
+        if not (isinstance(self.speed, int) and self.speed >= 1):
+            raise ScenarioError(f"moving obstacle speed must be an integer >= 1, got {self.speed!r}")
+        if self.mode not in ("pingpong", "loop"):
+            raise ScenarioError(f"moving obstacle mode must be 'pingpong' or 'loop', got {self.mode!r}")
+        path = [route[0]]
+        waypoints = list(route[1:]) + ([route[0]] if self.mode == "loop" else [])
+        for target in waypoints:
+            while (path[-1] != target).any():
+                path.append(path[-1] + np.sign(target - path[-1]))
+        unit = np.array(path)
+        if self.mode == "pingpong" and len(unit) > 1:
+            unit = np.vstack([unit, unit[-2:0:-1]])
+        elif self.mode == "loop" and len(unit) > 1:
+            unit = unit[:-1]
+        object.__setattr__(self, "cells", cells)
+        object.__setattr__(self, "route", route)
+        object.__setattr__(self, "_steps", unit)
+
+    @property
+    def period(self) -> int:
+        """Number of commands after which the obstacle is back where it started."""
+        n = len(self._steps)
+        return n // math.gcd(n, self.speed)
+
+    def displacement(self, t: int) -> np.ndarray:
+        """Displacement (dx, dy) at time t."""
+        return self._steps[(t * self.speed) % len(self._steps)]
+
+    def cells_at(self, t: int) -> np.ndarray:
+        """Cells covered at time t, shape (n, 2)."""
+        return self.cells + self.displacement(t)
+
+    def cells_during(self, t: int) -> np.ndarray:
+        """Cells covered at any instant between time t and t + 1 (every unit step in between)."""
+        start = t * self.speed
+        shifts = self._steps[np.arange(start, start + self.speed + 1) % len(self._steps)]
+        return (self.cells[None, :, :] + shifts[:, None, :]).reshape(-1, 2)
+
+
+@dataclass(frozen=True)
+class Workspace:
+    """A W × H grid of cells with static occupancy and optional moving obstacles.
+
+    Parameters
+    ----------
+    occupancy : array_like of bool, shape (H, W)
+        ``occ[y, x]``, True for an obstacle; row 0 is the bottom row.
+    cell_size : float
+        d_grid in metres (1.0 when the map has no scale).
+    moving : tuple of MovingObstacle
+        Obstacles that move while the robot executes commands.
+
+    Examples
+    --------
+    >>> ws = Workspace(np.zeros((3, 4), dtype=bool))
+    >>> ws.width, ws.height, ws.is_free(3, 2), ws.is_free(4, 0)
+    (4, 3, True, False)
+    """
+
+    occupancy: np.ndarray
+    cell_size: float = 1.0
+    moving: tuple[MovingObstacle, ...] = ()
+
+    def __post_init__(self) -> None:
+        occ = np.array(self.occupancy, dtype=bool)
+        if occ.ndim != 2 or occ.shape[0] == 0 or occ.shape[1] == 0:
+            raise ScenarioError(f"occupancy must be a non-empty 2-D array, got shape {occ.shape}")
+        if not (math.isfinite(self.cell_size) and self.cell_size > 0):
+            raise ScenarioError(f"cell_size must be a positive number, got {self.cell_size!r}")
+        occ.setflags(write=False)
+        object.__setattr__(self, "occupancy", occ)
+        object.__setattr__(self, "moving", tuple(self.moving))
+
+    @property
+    def width(self) -> int:
+        return int(self.occupancy.shape[1])
+
+    @property
+    def height(self) -> int:
+        return int(self.occupancy.shape[0])
+
+    @property
+    def period(self) -> int:
+        """Period of the moving obstacles in commands (1 for a static workspace)."""
+        return math.lcm(*(m.period for m in self.moving)) if self.moving else 1
+
+    def contains(self, x: int, y: int) -> bool:
+        return 0 <= x < self.width and 0 <= y < self.height
+
+    def is_free(self, x: int, y: int, t: int | None = None) -> bool:
+        """Whether a cell is inside the map and free (of moving obstacles too when ``t`` is given)."""
+        if not self.contains(x, y):
+            return False
+        occ = self.occupancy if t is None else self.occupancy_at(t)
+        return not occ[y, x]
+
+    def _mark(self, cells_of) -> np.ndarray:
+        occ = np.zeros_like(self.occupancy)
+        for obstacle in self.moving:
+            cells = cells_of(obstacle)
+            inside = (cells[:, 0] >= 0) & (cells[:, 0] < self.width) & (cells[:, 1] >= 0) & (cells[:, 1] < self.height)
+            occ[cells[inside, 1], cells[inside, 0]] = True
+        return occ
+
+    def moving_at(self, t: int) -> np.ndarray:
+        """Cells covered by moving obstacles at time t, as an (H, W) bool array."""
+        return self._mark(lambda m: m.cells_at(t))
+
+    def moving_during(self, t: int) -> np.ndarray:
+        """Cells covered by moving obstacles at any instant of step t → t + 1, (H, W) bool."""
+        return self._mark(lambda m: m.cells_during(t))
+
+    def occupancy_at(self, t: int) -> np.ndarray:
+        """Static and moving occupancy at time t, (H, W) bool."""
+        return self.occupancy | self.moving_at(t) if self.moving else self.occupancy
+
+    def without_moving(self) -> "Workspace":
+        """The same map with its moving obstacles removed."""
+        return Workspace(self.occupancy, self.cell_size)
+
+
+def grid_distance(workspace: Workspace, goal: tuple[int, int], *, diagonals: bool = False) -> np.ndarray:
+    """Shortest path length from every free cell to ``goal`` over free cells (MODEL.md §5, W_A*).
+
+    Moves are 4-connected with length 1 (plus diagonal moves of length √2 between free cells when
+    ``diagonals``, not cutting an obstacle corner); moving obstacles are ignored.
+
+    Parameters
+    ----------
+    workspace : Workspace
+    goal : (int, int)
+        The goal cell (x, y).
+    diagonals : bool, keyword-only
+
+    Returns
+    -------
+    ndarray of float, shape (H, W)
+        ``inf`` on obstacles and cells that cannot reach the goal.
+
+    Raises
+    ------
+    ConfigurationError
+        If the goal cell is outside the map or on an obstacle.
+
+    Examples
+    --------
+    >>> grid_distance(Workspace(np.zeros((1, 3), dtype=bool)), (0, 0)).tolist()
+    [[0.0, 1.0, 2.0]]
+    """
+    gx, gy = goal
+    if not workspace.is_free(gx, gy):
+        raise ConfigurationError(f"goal cell ({gx}, {gy}) is outside the map or on an obstacle")
+    free = ~workspace.occupancy
+    h, w = free.shape
+    index = np.arange(h * w).reshape(h, w)
+    rows, cols, weights = [], [], []
+    moves = [(1, 0, 1.0), (0, 1, 1.0)]
+    if diagonals:
+        moves += [(1, 1, math.sqrt(2.0)), (1, -1, math.sqrt(2.0))]
+    for dx, dy, length in moves:
+        ys = slice(max(0, -dy), h - max(0, dy))
+        xs = slice(0, w - dx)
+        ys2 = slice(max(0, dy), h - max(0, -dy))
+        xs2 = slice(dx, w)
+        ok = free[ys, xs] & free[ys2, xs2]
+        if dx and dy:  # no corner cutting
+            ok &= free[ys2, xs] & free[ys, xs2]
+        rows.append(index[ys, xs][ok])
+        cols.append(index[ys2, xs2][ok])
+        weights.append(np.full(int(ok.sum()), length))
+    r, c, wt = np.concatenate(rows), np.concatenate(cols), np.concatenate(weights)
+    graph = coo_matrix((wt, (r, c)), shape=(h * w, h * w)).tocsr()
+    dist = dijkstra(graph, directed=False, indices=int(index[gy, gx]))
+    return dist.reshape(h, w)

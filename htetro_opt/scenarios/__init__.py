@@ -1,0 +1,71 @@
+"""Scenario files and the bundled library of the papers' environments (shared/MODEL.md §6)."""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+from htetro_opt.errors import ScenarioError
+from htetro_opt.scenarios.loader import (
+    ContinuousScenario,
+    Scenario,
+    format_grid,
+    load_scenario_file,
+    parse_grid,
+    parse_scenario,
+)
+from htetro_opt.scenarios.rosmap import load_ros_map, read_pgm
+
+__all__ = [
+    "Scenario",
+    "ContinuousScenario",
+    "load_scenario",
+    "list_scenarios",
+    "scenario_path",
+    "load_scenario_file",
+    "parse_scenario",
+    "parse_grid",
+    "format_grid",
+    "load_ros_map",
+    "read_pgm",
+]
+
+
+def _data_dir() -> Path:
+    return Path(str(resources.files("htetro_opt.scenarios") / "data"))
+
+
+def list_scenarios() -> list[str]:
+    """Names of the bundled scenarios, sorted."""
+    return sorted(p.stem for p in _data_dir().glob("*.toml"))
+
+
+def scenario_path(name_or_path: str | Path) -> Path:
+    """Path of a bundled scenario name, or the given path if it names a file.
+
+    Raises
+    ------
+    ScenarioError
+        If it is neither a bundled name nor an existing file.
+    """
+    bundled = _data_dir() / f"{name_or_path}.toml"
+    if isinstance(name_or_path, str) and "/" not in name_or_path and bundled.is_file():
+        return bundled
+    path = Path(name_or_path)
+    if path.is_file():
+        return path
+    raise ScenarioError(
+        f"no scenario {str(name_or_path)!r}: not a bundled name ({', '.join(list_scenarios())}) nor a file"
+    )
+
+
+def load_scenario(name_or_path: str | Path) -> Scenario | ContinuousScenario:
+    """Load a bundled scenario by name, or a scenario file by path.
+
+    Examples
+    --------
+    >>> scenario = load_scenario("three_slit")
+    >>> scenario.workspace.width, scenario.start.shape
+    (24, 'O')
+    """
+    return load_scenario_file(scenario_path(name_or_path))

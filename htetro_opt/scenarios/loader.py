@@ -1,0 +1,331 @@
+"""Scenario files (shared/MODEL.md §6): one TOML file per environment.
+
+A grid scenario::
+
+    name = "three_slit"
+    source = "seed 000, Fig. 9d (reconstructed)"
+    description = "..."            # optional
+    cell_size_m = 0.25             # optional, d_grid in metres
+    grid = '''
+    ######
+    #....#
+    ######
+    '''                            # rows top first, '#' obstacle, '.' free
+    # or, instead of grid: map = "room.yaml"  (a ROS map_server map beside the file)
+    hidden = [[5, 11], [6, 11]]    # optional: obstacles the planner does not know of
+    [[roadmap]]                    # first = start, last = goal
+    x = 1
+    y = 1
+    shape = "O"
+    heading = 0                    # quarter turns, optional (0)
+    [[moving]]                     # optional moving obstacles
+    cells = [[3, 4], [4, 4]]       # cells at t = 0
+    route = [[0, 0], [0, 6]]       # displacement waypoints
+    speed = 1                      # cells per command, optional
+    mode = "pingpong"              # or "loop", optional
+
+A continuous scenario (seed 002) has ``width``, ``height``, ``obstacles`` (rectangles
+``[xmin, ymin, xmax, ymax]`` or polygons ``[[x, y], ...]``), ``robot_radius`` and ``[[robots]]`` with
+``start`` and ``goal`` points.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from htetro_opt.errors import ConfigurationError, MapFormatError, ScenarioError, UnknownShapeError
+from htetro_opt.model.robot import FOOTPRINTS, Pose, shape_index
+from htetro_opt.model.workspace import MovingObstacle, Workspace
+from htetro_opt.scenarios.rosmap import load_ros_map
+
+__all__ = ["Scenario", "ContinuousScenario", "load_scenario_file", "parse_scenario", "parse_grid", "format_grid"]
+
+_GRID_KEYS = {"name", "source", "description", "cell_size_m", "grid", "map", "roadmap", "moving", "hidden"}
+_CONTINUOUS_KEYS = {"name", "source", "description", "width", "height", "obstacles", "robot_radius", "robots"}
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A grid environment with its roadmap (first configuration = start, last = goal)."""
+
+    name: str
+    source: str
+    workspace: Workspace
+    roadmap: tuple[Pose, ...] = ()
+    description: str = ""
+    hidden: np.ndarray = field(default_factory=lambda: np.empty((0, 2), dtype=np.int64))
+    path: Path | None = None
+
+    @property
+    def start(self) -> Pose | None:
+        return self.roadmap[0] if self.roadmap else None
+
+    @property
+    def goal(self) -> Pose | None:
+        return self.roadmap[-1] if len(self.roadmap) > 1 else None
+
+    def true_workspace(self) -> Workspace:
+        """The workspace with its hidden obstacles revealed."""
+        occ = self.workspace.occupancy.copy()
+        occ[self.hidden[:, 1], self.hidden[:, 0]] = True
+        return Workspace(occ, self.workspace.cell_size, self.workspace.moving)
+
+
+@dataclass(frozen=True)
+class ContinuousScenario:
+    """A continuous W × H rectangle with polygon obstacles and point robots (seed 002)."""
+
+    name: str
+    source: str
+    width: float
+    height: float
+    obstacles: tuple[np.ndarray, ...]
+    robot_radius: float
+    starts: np.ndarray
+    goals: np.ndarray
+    description: str = ""
+    path: Path | None = None
+
+
+def parse_grid(text: str, *, where: str = "grid") -> np.ndarray:
+    """Occupancy ``occ[y, x]`` of a text grid (rows top first, ``#`` obstacle, ``.`` free).
+
+    Raises
+    ------
+    MapFormatError
+        On an empty grid, ragged rows or an unknown character, naming its row and column (1-based,
+        counted from the top).
+
+    Examples
+    --------
+    >>> parse_grid("#..\\n...").astype(int).tolist()
+    [[0, 0, 0], [1, 0, 0]]
+    """
+    if not isinstance(text, str):
+        raise MapFormatError(f"{where}: expected a string of rows, got {type(text).__name__}")
+    rows = [row.strip() for row in text.strip("\n").splitlines()]
+    while rows and not rows[0]:
+        rows.pop(0)
+    while rows and not rows[-1]:
+        rows.pop()
+    if not rows:
+        raise MapFormatError(f"{where}: the grid is empty")
+    width = len(rows[0])
+    for r, row in enumerate(rows, start=1):
+        if len(row) != width:
+            raise MapFormatError(f"{where}: row {r} has {len(row)} cells, row 1 has {width} (ragged grid)")
+        for c, char in enumerate(row, start=1):
+            if char not in "#.":
+                raise MapFormatError(f"{where}: unknown character {char!r} at row {r}, column {c} (use '#' or '.')")
+    occ = np.array([[char == "#" for char in row] for row in rows], dtype=bool)
+    return occ[::-1].copy()
+
+
+def format_grid(occupancy: np.ndarray) -> str:
+    """Text rows (top first) of an occupancy grid; the inverse of :func:`parse_grid`."""
+    return "\n".join("".join("#" if v else "." for v in row) for row in np.asarray(occupancy)[::-1])
+
+
+def _require(table: dict, key: str, kinds, where: str):
+    if key not in table:
+        raise ScenarioError(f"{where}: missing key {key!r}")
+    value = table[key]
+    if isinstance(value, bool) or not isinstance(value, kinds):
+        names = kinds.__name__ if isinstance(kinds, type) else " or ".join(k.__name__ for k in kinds)
+        raise ScenarioError(f"{where}: {key!r} must be {names}, got {type(value).__name__}")
+    return value
+
+
+def _cells(value: Any, where: str) -> np.ndarray:
+    try:
+        cells = np.array(value, dtype=np.int64).reshape(-1, 2)
+        if np.array(value).size and np.array(value).ndim != 2:
+            raise ValueError
+        if not np.array_equal(np.array(value, dtype=float).reshape(-1, 2), cells):
+            raise ValueError
+    except (TypeError, ValueError) as err:
+        raise ScenarioError(f"{where}: expected a list of [x, y] integer pairs") from err
+    return cells
+
+
+def _check_route(obstacle: MovingObstacle, occ: np.ndarray, where: str) -> None:
+    h, w = occ.shape
+    for t in range(obstacle.period):
+        for x, y in obstacle.cells_during(t).tolist():
+            if not (0 <= x < w and 0 <= y < h):
+                raise ScenarioError(f"{where}: the obstacle leaves the {w} x {h} map at ({x}, {y}) at time {t}")
+            if occ[y, x]:
+                raise ScenarioError(f"{where}: the obstacle runs into static obstacle cell ({x}, {y}) at time {t}")
+
+
+def _pose(entry: Any, where: str) -> Pose:
+    if not isinstance(entry, dict):
+        raise ScenarioError(f"{where}: expected a table with x, y, shape and heading")
+    unknown = set(entry) - {"x", "y", "shape", "heading"}
+    if unknown:
+        raise ScenarioError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
+    x = _require(entry, "x", int, where)
+    y = _require(entry, "y", int, where)
+    shape = _require(entry, "shape", str, where)
+    heading = entry.get("heading", 0)
+    try:
+        shape_index(shape)
+        return Pose.of(x, y, shape, heading)
+    except UnknownShapeError as err:
+        raise UnknownShapeError(f"{where}: {err}") from err
+    except ConfigurationError as err:
+        raise ConfigurationError(f"{where}: {err}") from err
+
+
+def _check_pose_on_map(pose: Pose, occ: np.ndarray, where: str) -> None:
+    cells = FOOTPRINTS[shape_index(pose.shape), pose.heading] + (pose.x, pose.y)
+    h, w = occ.shape
+    outside = [tuple(c) for c in cells.tolist() if not (0 <= c[0] < w and 0 <= c[1] < h)]
+    if outside:
+        raise ConfigurationError(
+            f"{where}: {pose.shape}-shape at ({pose.x}, {pose.y}) heading {pose.heading} "
+            f"has block(s) outside the {w} x {h} map at {outside}"
+        )
+    hits = [tuple(c) for c in cells.tolist() if occ[c[1], c[0]]]
+    if hits:
+        raise ConfigurationError(
+            f"{where}: {pose.shape}-shape at ({pose.x}, {pose.y}) heading {pose.heading} collides with obstacle cell(s) {hits}"
+        )
+
+
+def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = None) -> Scenario | ContinuousScenario:
+    """Build a scenario from a parsed TOML table (see the module docstring for the format).
+
+    Raises
+    ------
+    ScenarioError, MapFormatError
+        On missing, unknown or mistyped keys and malformed grids or maps.
+    ConfigurationError
+        If a roadmap configuration leaves the map or collides with an obstacle.
+    UnknownShapeError
+        If a roadmap configuration names an unknown shape.
+    """
+    if "width" in data or "robots" in data:
+        return _parse_continuous(data, where=where, base=base)
+    unknown = set(data) - _GRID_KEYS
+    if unknown:
+        raise ScenarioError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
+    name = _require(data, "name", str, where)
+    source = _require(data, "source", str, where)
+    description = data.get("description", "")
+    if ("grid" in data) == ("map" in data):
+        raise ScenarioError(f"{where}: give exactly one of 'grid' (text rows) or 'map' (a ROS map YAML)")
+    cell_size = data.get("cell_size_m")
+    if cell_size is not None and (isinstance(cell_size, bool) or not isinstance(cell_size, (int, float)) or not cell_size > 0):
+        raise ScenarioError(f"{where}: 'cell_size_m' must be a positive number")
+    if "grid" in data:
+        occ = parse_grid(_require(data, "grid", str, where), where=f"{where}: grid")
+        cell_size = float(cell_size) if cell_size is not None else 1.0
+    else:
+        map_path = Path(_require(data, "map", str, where))
+        if not map_path.is_absolute() and base is not None:
+            map_path = base / map_path
+        occ, cell_size = load_ros_map(map_path, cell_size=None if cell_size is None else float(cell_size))
+    moving = []
+    for i, entry in enumerate(data.get("moving", []), start=1):
+        at = f"{where}: moving[{i}]"
+        if not isinstance(entry, dict):
+            raise ScenarioError(f"{at}: expected a table")
+        extra = set(entry) - {"cells", "route", "speed", "mode"}
+        if extra:
+            raise ScenarioError(f"{at}: unknown key(s) {', '.join(sorted(extra))}")
+        cells = _cells(_require(entry, "cells", list, at), f"{at}: cells")
+        route = _cells(entry.get("route", [[0, 0]]), f"{at}: route")
+        obstacle = MovingObstacle(cells, route, speed=entry.get("speed", 1), mode=entry.get("mode", "pingpong"))
+        _check_route(obstacle, occ, at)
+        moving.append(obstacle)
+    hidden = _cells(data.get("hidden", []), f"{where}: hidden")
+    h, w = occ.shape
+    for x, y in hidden.tolist():
+        if not (0 <= x < w and 0 <= y < h):
+            raise ScenarioError(f"{where}: hidden obstacle ({x}, {y}) lies outside the {w} x {h} map")
+    entries = data.get("roadmap", [])
+    if not isinstance(entries, list):
+        raise ScenarioError(f"{where}: 'roadmap' must be an array of tables ([[roadmap]])")
+    workspace = Workspace(occ, cell_size, tuple(moving))
+    roadmap = []
+    for i, entry in enumerate(entries, start=1):
+        at = f"{where}: roadmap[{i}]" + (" (start)" if i == 1 else " (goal)" if i == len(entries) else "")
+        pose = _pose(entry, at)
+        _check_pose_on_map(pose, workspace.occupancy_at(0) if i == 1 else occ, at)
+        roadmap.append(pose)
+    return Scenario(name, source, workspace, tuple(roadmap), str(description), hidden, base)
+
+
+def _parse_continuous(data: dict, *, where: str, base: Path | None) -> ContinuousScenario:
+    unknown = set(data) - _CONTINUOUS_KEYS
+    if unknown:
+        raise ScenarioError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
+    name = _require(data, "name", str, where)
+    source = _require(data, "source", str, where)
+    width = float(_require(data, "width", (int, float), where))
+    height = float(_require(data, "height", (int, float), where))
+    radius = float(data.get("robot_radius", 0.0))
+    if not (width > 0 and height > 0 and radius >= 0 and math.isfinite(width * height * radius)):
+        raise ScenarioError(f"{where}: width and height must be positive and robot_radius >= 0")
+    obstacles = []
+    for i, item in enumerate(data.get("obstacles", []), start=1):
+        try:
+            arr = np.array(item, dtype=float)
+        except (TypeError, ValueError) as err:
+            raise ScenarioError(f"{where}: obstacles[{i}] is neither a rectangle nor a polygon") from err
+        if arr.shape == (4,):
+            x0, y0, x1, y1 = arr
+            if not (x0 < x1 and y0 < y1):
+                raise ScenarioError(f"{where}: obstacles[{i}] rectangle needs xmin < xmax and ymin < ymax")
+            arr = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+        elif arr.ndim != 2 or arr.shape[1] != 2 or len(arr) < 3:
+            raise ScenarioError(f"{where}: obstacles[{i}] must be [xmin, ymin, xmax, ymax] or >= 3 [x, y] points")
+        obstacles.append(arr)
+    robots = _require(data, "robots", list, where)
+    if not robots:
+        raise ScenarioError(f"{where}: 'robots' needs at least one robot")
+    starts, goals = [], []
+    for i, robot in enumerate(robots, start=1):
+        at = f"{where}: robots[{i}]"
+        if not isinstance(robot, dict) or set(robot) - {"start", "goal"}:
+            raise ScenarioError(f"{at}: expected a table with 'start' and 'goal'")
+        for key, out in (("start", starts), ("goal", goals)):
+            point = np.array(_require(robot, key, list, at), dtype=float)
+            if point.shape != (2,):
+                raise ScenarioError(f"{at}: {key} must be [x, y]")
+            if not (0 <= point[0] <= width and 0 <= point[1] <= height):
+                raise ConfigurationError(f"{at}: {key} {point.tolist()} lies outside the {width} x {height} workspace")
+            out.append(point)
+    return ContinuousScenario(
+        name, source, width, height, tuple(obstacles), radius, np.array(starts), np.array(goals),
+        str(data.get("description", "")), base,
+    )
+
+
+def load_scenario_file(path: str | Path) -> Scenario | ContinuousScenario:
+    """Read one scenario TOML file.
+
+    Raises
+    ------
+    ScenarioError
+        If the file cannot be read or is not valid TOML (with the parser's line and column).
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as err:
+        raise ScenarioError(f"{path}: cannot read scenario: {err.strerror or err}") from err
+    except UnicodeDecodeError as err:
+        raise ScenarioError(f"{path}: not a UTF-8 text file") from err
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise ScenarioError(f"{path}: malformed TOML: {err}") from err
+    return parse_scenario(data, where=str(path.name), base=path.parent)

@@ -1,0 +1,280 @@
+"""Exact minimum-time planning over (x, y, state, heading) — the reference for every heuristic.
+
+The search graph is the :class:`~htetro_opt.model.Simulator`'s own transition table: one node per
+pose, one edge per valid command weighted by its duration, so every plan re-validates in the
+simulator by construction. With moving obstacles the graph is time-expanded over their period
+(node = pose × time modulo the period; the obstacles' time is the number of commands executed, as in
+the simulator). A roadmap is planned leg by leg, each leg starting where and when the previous one
+ended (seed 000's configuration loop); each leg is time-optimal.
+
+Two algorithms give the same optimum: ``"dijkstra"`` (scipy.sparse.csgraph over the whole graph, the
+fastest here) and ``"astar"`` (a heapq A* that expands only what it needs, with the admissible
+heuristic "grid distance of B2's cell to the goal × the cheapest translation time per cell").
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+import time as _time
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from htetro_opt.errors import PlanningError
+from htetro_opt.model.commands import COMMANDS, Timing
+from htetro_opt.model.robot import Pose
+from htetro_opt.model.simulate import Simulator
+from htetro_opt.model.workspace import Workspace, grid_distance
+
+__all__ = ["Plan", "plan_exact", "ALGORITHMS"]
+
+ALGORITHMS = ("dijkstra", "astar")
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A plan: global command ids from the roadmap's start, and what it achieves.
+
+    ``reached`` is False when some leg has no path; ``commands`` then holds the legs planned before
+    it, and ``failed_leg`` the index of the leg that failed (−1 when reached).
+    """
+
+    commands: np.ndarray
+    reached: bool
+    time: float
+    poses: np.ndarray
+    leg_ends: tuple[int, ...]
+    failed_leg: int = -1
+    runtime_s: float = 0.0
+    method: str = "exact"
+    info: dict = field(default_factory=dict)
+
+    @property
+    def tokens(self) -> list[str]:
+        return [COMMANDS[int(c)].token for c in self.commands]
+
+    def objectives(self) -> dict:
+        """Path metrics: time, number of commands by kind, B2's travelled distance."""
+        kinds = [COMMANDS[int(c)].kind for c in self.commands]
+        shifts = np.array([COMMANDS[int(c)].shift for c in self.commands], dtype=float).reshape(-1, 2)
+        return {
+            "time": float(self.time),
+            "n_commands": len(kinds),
+            "translations": sum(k in ("translation", "diagonal") for k in kinds),
+            "rotations": sum(k == "rotation" or (k == "block" and COMMANDS[int(c)].turn != 0) for k, c in zip(kinds, self.commands)),
+            "shapeshifts": sum(k == "shapeshift" or (k == "block" and COMMANDS[int(c)].turn == 0) for k, c in zip(kinds, self.commands)),
+            "path_length": float(np.hypot(shifts[:, 0], shifts[:, 1]).sum()),
+        }
+
+
+class _Graph:
+    """Edges of a simulator's transition table, per obstacle phase, built on demand."""
+
+    def __init__(self, sim: Simulator) -> None:
+        self.sim = sim
+        n, c = sim.n_poses, sim.n_commands
+        target = sim.next[:n, :c].astype(np.int64)
+        source = np.broadcast_to(np.arange(n)[:, None], target.shape)
+        column = np.broadcast_to(np.arange(c)[None, :], target.shape)
+        keep = (target != sim.dead) & (target != source)
+        self.source, self.target, self.column = source[keep], target[keep], column[keep]
+        self.weight = sim.durations[self.column]
+        if (self.weight <= 0).any():
+            raise PlanningError("exact planning needs every command that moves the robot to take a positive time")
+        self._phases: dict[int, csr_matrix] = {}
+
+    def edges(self, phase: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(source, target, column, weight) of the edges usable at time ``phase``."""
+        if not self.sim.workspace.moving:
+            return self.source, self.target, self.column, self.weight
+        blocked = self.sim.blocked_keys(phase)
+        keys = self.source * self.sim.n_columns + self.column
+        ok = ~np.isin(keys, blocked, assume_unique=False)
+        return self.source[ok], self.target[ok], self.column[ok], self.weight[ok]
+
+    def matrix(self) -> csr_matrix:
+        """The whole (time-expanded when moving) graph as a CSR matrix, cheapest edge per node pair."""
+        period, n = self.sim.workspace.period, self.sim.n_poses
+        if 0 not in self._phases:
+            rows, cols, weights = [], [], []
+            for phase in range(period):
+                s, t, _, w = self.edges(phase)
+                rows.append(s + phase * n)
+                cols.append(t + ((phase + 1) % period) * n)
+                weights.append(w)
+            r, c, w = np.concatenate(rows), np.concatenate(cols), np.concatenate(weights)
+            order = np.lexsort((w, r * (n * period) + c))
+            r, c, w = r[order], c[order], w[order]
+            first = np.ones(len(r), dtype=bool)
+            first[1:] = (r[1:] != r[:-1]) | (c[1:] != c[:-1])
+            size = n * period
+            self._phases[0] = csr_matrix((w[first], (r[first], c[first])), shape=(size, size))
+        return self._phases[0]
+
+    def step_command(self, u: int, v: int, phase: int) -> int:
+        """Local command of the cheapest usable edge u → v at time ``phase``."""
+        sim = self.sim
+        row = sim.next[u, : sim.n_commands]
+        candidates = np.flatnonzero(row == v)
+        if sim.workspace.moving:
+            blocked = sim.blocked_keys(phase)
+            candidates = candidates[~np.isin(u * sim.n_columns + candidates, blocked)]
+        return int(candidates[np.argmin(sim.durations[candidates])])
+
+
+def _dijkstra_leg(graph: _Graph, start: int, goal: int, t0: int) -> list[int] | None:
+    sim = graph.sim
+    period, n = sim.workspace.period, sim.n_poses
+    source = (t0 % period) * n + start
+    dist, pred = dijkstra(graph.matrix(), indices=source, return_predecessors=True)
+    goal_nodes = goal + n * np.arange(period)
+    best = goal_nodes[np.argmin(dist[goal_nodes])]
+    if not np.isfinite(dist[best]):
+        return None
+    nodes = [int(best)]
+    while nodes[-1] != source:
+        nodes.append(int(pred[nodes[-1]]))
+    nodes.reverse()
+    return [graph.step_command(a % n, b % n, (a // n)) for a, b in zip(nodes[:-1], nodes[1:])]
+
+
+def _astar_leg(graph: _Graph, start: int, goal: int, t0: int, heuristic: np.ndarray) -> list[int] | None:
+    sim = graph.sim
+    period, n = sim.workspace.period, sim.n_poses
+    w = sim.workspace.width
+    cell_of = lambda pose: pose % (w * sim.workspace.height)  # noqa: E731 - (y * W + x) of a pose id
+    flat_h = heuristic.ravel()
+    durations = sim.durations[: sim.n_commands].tolist()
+    source = (t0 % period) * n + start
+    best = {source: 0.0}
+    parent: dict[int, tuple[int, int]] = {}
+    frontier = [(flat_h[cell_of(start)], 0.0, source)]
+    moving = bool(sim.workspace.moving)
+    while frontier:
+        _, g, node = heapq.heappop(frontier)
+        if g > best.get(node, math.inf):
+            continue
+        pose, phase = node % n, node // n
+        if pose == goal:
+            commands = []
+            while node != source:
+                node, column = parent[node]
+                commands.append(column)
+            return commands[::-1]
+        row = sim.next[pose, : sim.n_commands].tolist()
+        blocked = sim.blocked_keys(phase) if moving else None
+        next_phase = (phase + 1) % period
+        for column, target in enumerate(row):
+            if target == sim.dead or target == pose:
+                continue
+            if blocked is not None and len(blocked):
+                key = pose * sim.n_columns + column
+                at = np.searchsorted(blocked, key)
+                if at < len(blocked) and blocked[at] == key:
+                    continue
+            cost = g + durations[column]
+            child = next_phase * n + target
+            if cost < best.get(child, math.inf):
+                best[child] = cost
+                parent[child] = (node, column)
+                heapq.heappush(frontier, (cost + flat_h[cell_of(target)], cost, child))
+    return None
+
+
+def plan_exact(
+    workspace: Workspace | Simulator,
+    roadmap: Sequence[Pose],
+    *,
+    diagonals: bool = False,
+    commands: Sequence[str] | None = None,
+    timing: Timing | None = None,
+    clearance: float = 0.0,
+    algorithm: str = "dijkstra",
+) -> Plan:
+    """Minimum-time plan through a roadmap of configurations.
+
+    Parameters
+    ----------
+    workspace : Workspace or Simulator
+        The map, or an already compiled simulator (then the command options below are ignored).
+    roadmap : sequence of Pose
+        Start first, goal last, at least two configurations.
+    diagonals : bool, keyword-only
+        Allow the four diagonal translations (seed 001).
+    commands : sequence of str, optional, keyword-only
+        Command tokens to plan with (default: seed 000's set, plus diagonals when asked).
+    timing : Timing, optional, keyword-only
+    clearance : float, keyword-only
+        δ in cells (MODEL.md §4).
+    algorithm : {"dijkstra", "astar"}, keyword-only
+
+    Returns
+    -------
+    Plan
+        ``reached`` is False (not an exception) when a leg has no path.
+
+    Raises
+    ------
+    PlanningError
+        If the roadmap has fewer than two configurations or the algorithm is unknown.
+    ConfigurationError
+        If the start collides or a configuration is outside the map.
+
+    Examples
+    --------
+    >>> ws = Workspace(np.zeros((5, 5), dtype=bool))
+    >>> plan = plan_exact(ws, [Pose(1, 1, "O", 0), Pose(3, 2, "O", 0)])
+    >>> plan.reached, plan.time, len(plan.tokens)
+    (True, 3.0, 3)
+    """
+    if algorithm not in ALGORITHMS:
+        raise PlanningError(f"unknown algorithm {algorithm!r}: expected one of {', '.join(ALGORITHMS)}")
+    roadmap = [Pose.of(*p) for p in roadmap]
+    if len(roadmap) < 2:
+        raise PlanningError("a roadmap needs a start and a goal (at least two configurations)")
+    began = _time.perf_counter()
+    sim = workspace if isinstance(workspace, Simulator) else Simulator(
+        workspace, commands=commands, diagonals=diagonals, timing=timing, clearance=clearance
+    )
+    graph = _Graph(sim)
+    ids = [sim.check_pose(roadmap[0], what="start", t=0)]
+    for i, pose in enumerate(roadmap[1:], start=1):
+        what = "goal" if i == len(roadmap) - 1 else f"roadmap configuration {i + 1}"
+        ids.append(sim.check_pose(pose, what=what))
+    has_diagonals = any(COMMANDS[int(c)].kind == "diagonal" for c in sim.command_ids)
+    per_cell = min(
+        [sim.timing.translation] + ([sim.timing.diagonal / math.sqrt(2.0)] if has_diagonals else [])
+    )
+    local: list[int] = []
+    leg_ends: list[int] = []
+    failed = -1
+    for leg, (a, b) in enumerate(zip(ids[:-1], ids[1:])):
+        if algorithm == "dijkstra":
+            steps = _dijkstra_leg(graph, a, b, len(local))
+        else:
+            goal_cell = tuple(int(v) for v in sim.decode(b)[:2])
+            h = grid_distance(sim.workspace, goal_cell, diagonals=has_diagonals) * per_cell
+            steps = _astar_leg(graph, a, b, len(local), np.where(np.isfinite(h), h, np.inf))
+        if steps is None:
+            failed = leg
+            break
+        local.extend(steps)
+        leg_ends.append(len(local))
+    global_ids = sim.command_ids[np.array(local, dtype=np.int64)] if local else np.empty(0, dtype=np.int64)
+    result = sim.run([global_ids], ids[0])
+    if not result.valid[0]:  # the graph is the simulator's table: this cannot happen unless tables disagree
+        raise PlanningError("internal error: the exact plan does not re-validate in the simulator")
+    return Plan(
+        commands=global_ids,
+        reached=failed < 0,
+        time=float(result.time[0]),
+        poses=result.poses(0),
+        leg_ends=tuple(leg_ends),
+        failed_leg=failed,
+        runtime_s=_time.perf_counter() - began,
+        method=f"exact-{algorithm}",
+    )

@@ -1,0 +1,152 @@
+"""Plots of maps and plans (matplotlib is imported lazily; nothing here computes a plan)."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from htetro_opt.errors import HtetroError
+from htetro_opt.model.robot import FOOTPRINTS, SHAPES, STATE_NAMES, Pose, shape_index
+from htetro_opt.model.workspace import Workspace
+
+__all__ = ["SHAPE_COLOURS", "plot_path", "save_figure"]
+
+SHAPE_COLOURS = {
+    "I": "#1f77b4", "O": "#ff7f0e", "L": "#2ca02c", "J": "#d62728",
+    "Z": "#9467bd", "S": "#8c564b", "T": "#e377c2",
+}
+_INTERMEDIATE_COLOUR = "#7f7f7f"
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _colour(state: int) -> str:
+    return SHAPE_COLOURS.get(STATE_NAMES[state], _INTERMEDIATE_COLOUR)
+
+
+def plot_path(
+    workspace: Workspace,
+    poses: np.ndarray,
+    *,
+    roadmap: tuple[Pose, ...] = (),
+    hidden: np.ndarray | None = None,
+    title: str = "",
+    ax=None,
+):
+    """Draw a map and the robot's footprints along a path.
+
+    Parameters
+    ----------
+    workspace : Workspace
+    poses : ndarray of int, shape (n, 4)
+        (x, y, state, heading) of the poses visited, in order.
+    roadmap : tuple of Pose, keyword-only
+        Configurations to outline (start green, intermediate blue, goal red).
+    hidden : ndarray, shape (m, 2), optional, keyword-only
+        Obstacles unknown to the planner, drawn hatched.
+    title : str, keyword-only
+    ax : matplotlib Axes, optional, keyword-only
+
+    Returns
+    -------
+    matplotlib Figure
+    """
+    plt = _pyplot()
+    from matplotlib.patches import Patch, Rectangle
+
+    poses = np.asarray(poses, dtype=int).reshape(-1, 4)
+    if ax is None:
+        side = 7.0
+        aspect = workspace.height / workspace.width
+        fig, ax = plt.subplots(figsize=(side, max(3.0, side * aspect) + 0.6), constrained_layout=True)
+    else:
+        fig = ax.figure
+    w, h = workspace.width, workspace.height
+    ax.imshow(workspace.occupancy, cmap="Greys", vmin=0, vmax=1.4, origin="lower",
+              extent=(-0.5, w - 0.5, -0.5, h - 0.5), interpolation="nearest")
+    if w <= 64 and h <= 64:
+        ax.set_xticks(np.arange(-0.5, w, 1), minor=True)
+        ax.set_yticks(np.arange(-0.5, h, 1), minor=True)
+        ax.grid(which="minor", color="#dddddd", linewidth=0.4)
+        ax.tick_params(which="minor", length=0)
+    for obstacle in workspace.moving:
+        start_cells = obstacle.cells_at(0)
+        track = np.concatenate([obstacle.cells_at(t) for t in range(obstacle.period)])
+        for x, y in np.unique(track, axis=0):
+            ax.add_patch(Rectangle((x - 0.5, y - 0.5), 1, 1, facecolor="none", edgecolor="#555555", hatch="..", linewidth=0))
+        for x, y in start_cells:
+            ax.add_patch(Rectangle((x - 0.5, y - 0.5), 1, 1, facecolor="#555555", alpha=0.8))
+    if hidden is not None:
+        for x, y in np.asarray(hidden).reshape(-1, 2):
+            ax.add_patch(Rectangle((x - 0.5, y - 0.5), 1, 1, facecolor="none", edgecolor="black", hatch="xx"))
+    used = []
+    change = np.ones(len(poses), dtype=bool)
+    if len(poses) > 1:
+        change[1:] = (poses[1:, 2] != poses[:-1, 2]) | (poses[1:, 3] != poses[:-1, 3])
+    change[-1:] = True
+    for i, (x, y, s, hd) in enumerate(poses):
+        colour = _colour(s)
+        if STATE_NAMES[s] not in used:
+            used.append(STATE_NAMES[s])
+        for bx, by in FOOTPRINTS[s, hd] + (x, y):
+            ax.add_patch(Rectangle((bx - 0.5, by - 0.5), 1, 1, facecolor=colour, alpha=0.12, linewidth=0))
+            if change[i]:
+                ax.add_patch(Rectangle((bx - 0.45, by - 0.45), 0.9, 0.9, facecolor="none", edgecolor=colour, linewidth=1.2))
+    if len(poses):
+        ax.plot(poses[:, 0], poses[:, 1], color="black", linewidth=1.2, marker=".", markersize=3, label="B2 path")
+    for i, pose in enumerate(roadmap):
+        edge = "green" if i == 0 else "red" if i == len(roadmap) - 1 else "blue"
+        for bx, by in FOOTPRINTS[shape_index(pose.shape), pose.heading] + (pose.x, pose.y):
+            ax.add_patch(Rectangle((bx - 0.5, by - 0.5), 1, 1, facecolor="none", edgecolor=edge, linewidth=2.2, linestyle="--"))
+    handles = [Patch(facecolor=_colour(shape_index(n)), alpha=0.6, label=f"{n}-shape" if n in SHAPES else n) for n in used]
+    if roadmap:
+        handles.append(Patch(facecolor="none", edgecolor="green", linestyle="--", label="start"))
+        handles.append(Patch(facecolor="none", edgecolor="red", linestyle="--", label="goal"))
+    if handles:
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
+    ax.set_xlim(-0.5, w - 0.5)
+    ax.set_ylim(-0.5, h - 0.5)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (cells)")
+    ax.set_ylabel("y (cells)")
+    if title:
+        ax.set_title(title, fontsize=10)
+    return fig
+
+
+def save_figure(fig, path: str | Path, *, dpi: int = 120) -> Path:
+    """Save a figure as PNG atomically (a temporary file renamed into place), then close it.
+
+    Raises
+    ------
+    HtetroError
+        If the directory does not exist or the file cannot be written.
+    """
+    plt = _pyplot()
+    path = Path(path)
+    directory = path.parent if str(path.parent) else Path(".")
+    if not directory.is_dir():
+        plt.close(fig)
+        raise HtetroError(f"cannot write plot {str(path)!r}: directory {str(directory)!r} does not exist")
+    handle, tmp = tempfile.mkstemp(suffix=".png", prefix=".htetro-", dir=directory)
+    os.close(handle)
+    try:
+        fig.savefig(tmp, dpi=dpi, format="png")
+        os.replace(tmp, path)
+    except OSError as err:
+        raise HtetroError(f"cannot write plot {str(path)!r}: {err.strerror or err}") from err
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        plt.close(fig)
+    return path
