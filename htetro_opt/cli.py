@@ -53,7 +53,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plot", metavar="FILE", help="save a PNG of the map and the path")
 
-    p = sub.add_parser("simulate", help="execute a command sequence in a scenario")
+    p = sub.add_parser(
+        "simulate",
+        help="execute a command sequence in a scenario",
+        description="Execute a command sequence from the scenario's start in the true world (hidden "
+        "obstacles included). 'reached' means the whole sequence is valid, passes through the roadmap's "
+        "configurations in order and ends on the goal; 'executed' counts the commands run before the "
+        "first invalid one.",
+    )
     p.add_argument("scenario", help="bundled scenario name or path to a scenario TOML file")
     p.add_argument("--commands", required=True, help='comma- or space-separated tokens, e.g. "x+,x+,sI"')
     p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block")
@@ -136,13 +143,14 @@ def _cmd_simulate(args) -> dict:
         raise PlanningError(f"scenario {scenario.name!r} has no start configuration to simulate from")
     sequence = parse_commands(args.commands)
     used = sorted(set(SEED000_COMMANDS) | set(DIAGONAL_COMMANDS) | {t for t in args.commands.replace(",", " ").split()})
-    sim = Simulator(scenario.workspace, commands=used, clearance=clearance)
+    world = scenario.true_workspace()
+    sim = Simulator(world, commands=used, clearance=clearance)
     result = sim.run([sequence], scenario.start, roadmap=scenario.roadmap[1:])
     first_invalid = int(result.first_invalid[0])
     out = {
         "scenario": scenario.name,
         "valid": bool(result.valid[0]),
-        "reached": bool(result.reached[0]),
+        "reached": bool(result.valid[0] and result.reached[0]),
         "executed": int(result.executed[0]),
         "first_invalid": None if first_invalid < 0 else first_invalid,
         "final": _pose_dict(result.final[0]),
@@ -153,7 +161,7 @@ def _cmd_simulate(args) -> dict:
 
         state = "valid" if out["valid"] else f"invalid at command {first_invalid + 1}"
         title = f"{scenario.name}: {out['executed']} of {len(sequence)} commands executed ({state})"
-        save_figure(plot_path(scenario.workspace, result.poses(0), roadmap=scenario.roadmap,
+        save_figure(plot_path(world, result.poses(0), roadmap=scenario.roadmap,
                               hidden=scenario.hidden, title=title), args.plot)
     if not args.json:
         f = out["final"]
@@ -172,12 +180,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         args = parser.parse_args(argv)
         out = _COMMANDS[args.command](args)
-    except _UsageError as err:
-        print(f"error: {err}", file=sys.stderr)
+    except (_UsageError, HtetroError) as err:
+        print("error: " + " ".join(str(err).split()), file=sys.stderr)
         return EXIT_ERROR
-    except HtetroError as err:
-        print(f"error: {err}", file=sys.stderr)
-        return EXIT_ERROR
+    except SystemExit as done:  # --help and --version
+        return int(done.code or 0)
     if getattr(args, "json", False):
         print(json.dumps(out))
     return 0

@@ -4,7 +4,8 @@ A :class:`Simulator` compiles, once per workspace, command set, timing and clear
 table ``next[pose, command]``: poses are the flat ids ``((state * 4 + heading) * H + y) * W + x``,
 ``next`` holds the pose after the command or ``dead`` where the command's swept cells are not all
 inside the map and free, and an extra ``pad`` command leaves every pose unchanged. Simulating a batch
-is then one gather per step for the whole batch. Moving obstacles add, per time step, a sorted array
+is then one add and one gather per step for the whole batch (the table is kept premultiplied by its
+column count, so the gathered value plus the next command is the next index). Moving obstacles add, per time step, a sorted array
 of blocked ``pose * n_columns + command`` keys (the swept-cell table turned inside out), checked with
 one ``searchsorted`` per step.
 
@@ -40,7 +41,7 @@ __all__ = ["Simulator", "SimulationResult", "simulate"]
 _STOP = command_id("stop")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SimulationResult:
     """Outcome of simulating a batch of command sequences.
 
@@ -62,7 +63,8 @@ class SimulationResult:
     final : ndarray of int, shape (B, 4)
         Final (x, y, state, heading).
     trace : ndarray of int, shape (B, L + 1)
-        Pose ids after each command; entries past ``executed`` are meaningless.
+        Pose ids after each command (``simulator.dead`` once invalid); entries past ``executed`` are
+        meaningless. Computed on first use.
     """
 
     valid: np.ndarray
@@ -72,11 +74,15 @@ class SimulationResult:
     progress: np.ndarray
     time: np.ndarray
     final: np.ndarray
-    trace: np.ndarray
     simulator: "Simulator"
+    keys: np.ndarray  # (L + 1, B) of pose * n_columns, as the simulation loop leaves them
 
     def __len__(self) -> int:
         return len(self.valid)
+
+    @cached_property
+    def trace(self) -> np.ndarray:
+        return (self.keys // self.simulator.n_columns).T.astype(np.int64)
 
     def poses(self, i: int) -> np.ndarray:
         """Poses visited by sequence i, start included: shape (executed + 1, 4) of (x, y, state, heading)."""
@@ -167,25 +173,27 @@ class Simulator:
     def _transition_table(self) -> np.ndarray:
         t, ws = self.tables, self.workspace
         h, w, S, C = ws.height, ws.width, self.n_states, self.n_commands
-        valid = self._valid_table(~ws.occupancy)
+        dtype = np.int32 if (self.n_poses + 1) * self.n_columns < 2**31 else np.int64
+        ok = self._valid_table(~ws.occupancy).transpose(0, 1, 3, 4, 2)  # (S, 4, H, W, C)
         target_state = t.next_state[:S][:, self.command_ids].clip(0)  # (S, C)
         target_heading = t.next_heading[:S][:, :, self.command_ids]  # (S, 4, C)
         dx, dy = t.shift[self.command_ids, 0], t.shift[self.command_ids, 1]
-        ys, xs = np.arange(h)[:, None, None], np.arange(w)[None, :, None]
-        # pose id of the target, laid out (S, 4, H, W, C); out-of-map targets are masked by `valid`.
-        base = (target_state[:, None, :] * N_HEADINGS + target_heading)[:, :, None, None, :]
-        target = (base * h + (ys + dy)) * w + (xs + dx)
-        ok = valid.transpose(0, 1, 3, 4, 2)
-        table = np.empty((self.n_poses + 1, self.n_columns), dtype=np.int64)
-        table[:-1, :C] = np.where(ok, target, self.dead).reshape(-1, C)
-        table[:-1, C] = np.arange(self.n_poses)
+        # pose id of the target = ((state' * 4 + heading') * H + y + dy) * W + x + dx, split into a
+        # per-(state, heading, command) part and a per-cell part; out-of-map targets are masked by `ok`.
+        entry = ((target_state[:, None, :] * N_HEADINGS + target_heading) * h + dy) * w + dx
+        cell = np.arange(h * w, dtype=dtype).reshape(h, w)
+        table = np.empty((self.n_poses + 1, self.n_columns), dtype=dtype)
+        view = table[:-1, :C].reshape(S, N_HEADINGS, h, w, C)
+        np.add(entry.astype(dtype)[:, :, None, None, :], cell[None, None, :, :, None], out=view)
+        np.putmask(view, ~ok, self.dead)
+        table[:-1, C] = np.arange(self.n_poses, dtype=dtype)
         table[-1] = self.dead
-        dtype = np.int32 if self.n_poses < 2**31 - 1 else np.int64
-        return table.astype(dtype)
+        return table
 
     @cached_property
     def _flat_next(self) -> np.ndarray:
-        return self.next.ravel()
+        """``next * n_columns`` flattened: a step is ``key' = flat[key + command]`` with key = pose * n_columns."""
+        return (self.next * self.n_columns).ravel()
 
     @cached_property
     def _sweep_entries(self) -> np.ndarray:
@@ -244,13 +252,19 @@ class Simulator:
         sh = ids // (ws.width * ws.height)
         return np.stack([x, y, sh // N_HEADINGS, sh % N_HEADINGS], axis=-1)
 
-    def pose_free(self, pose_id: int, t: int | None = None) -> bool:
-        """Whether a pose's footprint (with clearance) is inside the map and free (at time t)."""
+    def pose_conflicts(self, pose_id: int, t: int | None = None) -> list[tuple[int, int]]:
+        """Cells of a pose's footprint (with clearance) that lie outside the map or on an obstacle.
+
+        With ``t``, moving obstacles at time t count too.
+        """
         x, y, s, h = (int(v) for v in self.decode(pose_id))
+        ws = self.workspace
+        occ = ws.occupancy if t is None else ws.occupancy_at(t)
         cells = self.tables.cells(s, h, _STOP) + (x, y)
-        occ = self.workspace.occupancy if t is None else self.workspace.occupancy_at(t)
-        inside = (cells[:, 0] >= 0) & (cells[:, 0] < self.workspace.width) & (cells[:, 1] >= 0) & (cells[:, 1] < self.workspace.height)
-        return bool(inside.all() and not occ[cells[:, 1], cells[:, 0]].any())
+        return [
+            (cx, cy) for cx, cy in cells.tolist()
+            if not ws.contains(cx, cy) or occ[cy, cx]
+        ]
 
     def check_pose(self, pose: Pose, *, what: str = "pose", t: int | None = None) -> int:
         """Encode a pose and check it is collision-free; its flat id.
@@ -258,36 +272,46 @@ class Simulator:
         Raises
         ------
         ConfigurationError
-            Naming ``what`` (e.g. "start") if the pose lies outside the map or collides.
+            Naming ``what`` (e.g. "start") and the offending cells if the pose lies outside the map or
+            collides.
         """
         try:
             pid = self.encode(pose)
         except ConfigurationError as err:
             raise ConfigurationError(f"{what} {tuple(pose)}: {err}") from err
-        if not self.pose_free(pid, t):
+        conflicts = self.pose_conflicts(pid, t)
+        if conflicts:
+            margin = f" (with clearance {self.tables.clearance:g})" if self.tables.clearance else ""
+            when = "" if t is None else f" at time {t}"
             raise ConfigurationError(
-                f"{what} {tuple(pose)} collides with an obstacle or leaves the map"
-                + ("" if t is None else f" at time {t}")
+                f"{what} {tuple(pose)}{margin} collides with obstacles or the map edge{when} at cells {conflicts}"
             )
         return pid
 
     # --- simulation --------------------------------------------------------------------------
-    def _local_commands(self, sequences: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-        lengths = np.fromiter((len(s) for s in sequences), dtype=np.int64, count=len(sequences))
-        width = int(lengths.max()) if len(lengths) else 0
-        local = np.full((len(sequences), width), self.pad, dtype=np.int64)
-        for i, seq in enumerate(sequences):
-            local[i, : lengths[i]] = seq
-        if local.size:
-            ids = local[local != self.pad]
-            bad = (ids < 0) | (ids >= N_COMMANDS)
-            if bad.any():
-                raise UnknownCommandError(f"command id {int(ids[bad][0])} is not a command")
-            mapped = self.local[ids]
-            if (mapped < 0).any():
-                token = TOKENS[int(ids[mapped < 0][0])]
-                raise UnknownCommandError(f"command {token!r} is not in this simulator's command set")
-            local[local != self.pad] = mapped
+    def _local_commands(self, sequences) -> tuple[np.ndarray, np.ndarray]:
+        """Sequences of global ids as one (B, L) array of local columns, padded with ``pad``."""
+        if isinstance(sequences, np.ndarray) and sequences.ndim == 2:
+            ids = sequences.astype(np.int64, copy=False)
+            lengths = np.full(len(ids), ids.shape[1], dtype=np.int64)
+            present = None
+        else:
+            sequences = list(sequences)
+            lengths = np.fromiter((len(s) for s in sequences), dtype=np.int64, count=len(sequences))
+            width = int(lengths.max()) if len(lengths) else 0
+            present = np.arange(width)[None, :] < lengths[:, None]
+            ids = np.concatenate([np.asarray(s, dtype=np.int64).ravel() for s in sequences]) if width else np.empty(0, np.int64)
+        bad = (ids < 0) | (ids >= N_COMMANDS)
+        if bad.any():
+            raise UnknownCommandError(f"command id {int(ids[bad][0])} is not a command")
+        mapped = self.local[ids]
+        if (mapped < 0).any():
+            token = TOKENS[int(ids[mapped < 0][0])]
+            raise UnknownCommandError(f"command {token!r} is not in this simulator's command set")
+        if present is None:
+            return mapped, lengths
+        local = np.full(present.shape, self.pad, dtype=np.int64)
+        local[present] = mapped
         return local, lengths
 
     def run(
@@ -328,58 +352,72 @@ class Simulator:
         """
         start_id = start if isinstance(start, (int, np.integer)) else self.check_pose(start, what="start", t=t0)
         goals = np.array([self.encode(p) for p in roadmap], dtype=np.int64) if roadmap else np.empty(0, np.int64)
-        local, lengths = self._local_commands(list(sequences))
+        local, lengths = self._local_commands(sequences)
+        keys = self._step_all(local, lengths, start_id * self.n_columns, t0)
+        return self._summarise(keys, local, lengths, goals * self.n_columns, stop_at_goal)
+
+    def _step_all(self, local: np.ndarray, lengths: np.ndarray, start_key: int, t0: int) -> np.ndarray:
+        """Keys ``pose * n_columns`` after each step, shape (L + 1, B): the hot loop."""
         batch, width = local.shape
-        trace = np.empty((batch, width + 1), dtype=np.int64)
-        pose = np.full(batch, start_id, dtype=np.int64)
-        trace[:, 0] = pose
-        flat, columns, dead = self._flat_next, self.n_columns, self.dead
+        flat = self._flat_next
+        columns, dead_key = self.n_columns, self.dead * self.n_columns
+        steps = np.ascontiguousarray(local.T, dtype=flat.dtype)  # (L, B): one contiguous row per step
+        keys = np.empty((width + 1, batch), dtype=flat.dtype)
+        keys[0] = start_key
+        index = np.empty(batch, dtype=flat.dtype)
+        add, take = np.add, flat.take
         moving = bool(self.workspace.moving)
         for t in range(width):
-            keys = pose * columns + local[:, t]
-            pose = flat[keys].astype(np.int64)
+            if t % 8 == 0 and t and not ((keys[t] != dead_key) & (lengths > t)).any():
+                keys[t + 1 :] = keys[t]  # every sequence has died or ended: nothing changes any more
+                break
+            add(keys[t], steps[t], out=index)
+            take(index, out=keys[t + 1])
             if moving:
                 blocked = self.blocked_keys(t0 + t)
                 if len(blocked):
-                    at = np.searchsorted(blocked, keys).clip(max=len(blocked) - 1)
-                    pose[blocked[at] == keys] = dead
-            trace[:, t + 1] = pose
-        return self._summarise(trace, local, lengths, goals, stop_at_goal)
+                    at = np.searchsorted(blocked, index).clip(max=len(blocked) - 1)
+                    keys[t + 1][blocked[at] == index] = dead_key
+        return keys
 
-    def _summarise(self, trace, local, lengths, goals, stop_at_goal) -> SimulationResult:
-        batch, width = local.shape
-        steps = np.arange(width + 1)
+    def _summarise(self, keys, local, lengths, goal_keys, stop_at_goal) -> SimulationResult:
+        """Per-sequence outcome from the (L + 1, B) keys of a run."""
+        width, batch = keys.shape[0] - 1, keys.shape[1]
+        steps = np.arange(width + 1)[:, None]
         # Roadmap progress: the first step at or after the previous hit where the next pose is met.
         progress = np.ones(batch, dtype=np.int64)
         when = np.zeros(batch, dtype=np.int64)
-        for k, goal in enumerate(goals, start=1):
-            hit = (trace == goal) & (steps[None, :] >= when[:, None]) & (progress == k)[:, None]
-            found = hit.any(axis=1)
+        for k, goal in enumerate(goal_keys, start=1):
+            hit = (keys == goal) & (steps >= when) & (progress == k)
+            found = hit.any(axis=0)
             progress[found] += 1
-            when[found] = hit.argmax(axis=1)[found]
-        run_length = lengths.copy()
-        done = progress == len(goals) + 1
-        if stop_at_goal and len(goals):
-            run_length[done] = np.minimum(run_length[done], when[done])
-        dead_step = (trace[:, 1:] == self.dead) & (steps[None, 1:] <= run_length[:, None])
+            when[found] = hit.argmax(axis=0)[found]
+        run_length = lengths
+        done = progress == len(goal_keys) + 1
+        if stop_at_goal and len(goal_keys):
+            run_length = np.where(done, np.minimum(lengths, when), lengths)
+        died = keys[1:] == self.dead * self.n_columns
+        if not (run_length == width).all():
+            died &= steps[1:] <= run_length
         first_invalid = np.full(batch, -1, dtype=np.int64)
         if width:
-            first_invalid = np.where(dead_step.any(axis=1), dead_step.argmax(axis=1), -1)
+            any_died = died.any(axis=0)
+            first_invalid[any_died] = died.argmax(axis=0)[any_died]
         executed = np.where(first_invalid >= 0, first_invalid, run_length)
-        final_ids = trace[np.arange(batch), executed]
-        reached = done & (final_ids == goals[-1]) if len(goals) else np.zeros(batch, dtype=bool)
-        ran = steps[None, 1:] <= executed[:, None]
-        time = np.where(ran, self.durations[local], 0.0).sum(axis=1)
+        final_ids = keys[executed, np.arange(batch)] // self.n_columns
+        reached = done & (final_ids * self.n_columns == goal_keys[-1]) if len(goal_keys) else np.zeros(batch, dtype=bool)
+        durations = self.durations[local]
+        durations[np.arange(width)[None, :] >= executed[:, None]] = 0.0
         return SimulationResult(
             valid=first_invalid < 0,
             first_invalid=first_invalid,
             executed=executed,
             reached=reached,
             progress=progress,
-            time=time,
+            time=durations.sum(axis=1),
             final=self.decode(final_ids),
-            trace=trace,
             simulator=self,
+            keys=keys,
         )
 
 

@@ -161,7 +161,6 @@ def _self_overlap(centres: np.ndarray, angles: np.ndarray) -> bool:
     return False
 
 
-@lru_cache(maxsize=8)
 def sweep_tables(clearance: float = 0.0) -> SweepTables:
     """The robot's swept-cell and transition tables for a clearance δ (cached per δ).
 
@@ -180,8 +179,13 @@ def sweep_tables(clearance: float = 0.0) -> SweepTables:
     >>> int(tables.counts[0, 0, 8])  # the I-shape turning by +90°
     16
     """
-    if not (isinstance(clearance, (int, float)) and math.isfinite(clearance) and clearance >= 0):
+    if isinstance(clearance, bool) or not (isinstance(clearance, (int, float)) and math.isfinite(clearance) and clearance >= 0):
         raise ValueError(f"clearance must be a finite number >= 0, got {clearance!r}")
+    return _sweep_tables(float(clearance))
+
+
+@lru_cache(maxsize=8)
+def _sweep_tables(clearance: float) -> SweepTables:
     state_index = {triple: i for i, triple in enumerate(HINGE_STATES)}
     legal = np.zeros((N_STATES, N_COMMANDS), dtype=bool)
     next_state = np.full((N_STATES, N_COMMANDS), -1, dtype=np.int64)

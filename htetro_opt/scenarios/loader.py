@@ -142,6 +142,37 @@ def _require(table: dict, key: str, kinds, where: str):
     return value
 
 
+def _array(data: dict, key: str, where: str, *, tables: bool = False) -> list:
+    value = data.get(key, [])
+    if not isinstance(value, list):
+        kind = f"an array of tables ([[{key}]])" if tables else "an array"
+        raise ScenarioError(f"{where}: {key!r} must be {kind}, got {type(value).__name__}")
+    return value
+
+
+def _number(table: dict, key: str, where: str, default=None) -> float:
+    value = table.get(key, default)
+    if value is None:
+        raise ScenarioError(f"{where}: missing key {key!r}")
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ScenarioError(f"{where}: {key!r} must be a number, got {value!r}")
+    return float(value)
+
+
+def _point_in_obstacle(point: np.ndarray, polygon: np.ndarray, radius: float) -> bool:
+    """Whether a point lies inside a polygon or within ``radius`` of its boundary."""
+    x, y = point
+    inside = False
+    for (x0, y0), (x1, y1) in zip(polygon, np.roll(polygon, -1, axis=0)):
+        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
+            inside = not inside
+        edge = np.array([x1 - x0, y1 - y0])
+        t = np.clip(np.dot(point - (x0, y0), edge) / max(np.dot(edge, edge), 1e-300), 0.0, 1.0)
+        if np.hypot(*(point - (np.array([x0, y0]) + t * edge))) < radius:
+            return True
+    return inside
+
+
 def _cells(value: Any, where: str) -> np.ndarray:
     try:
         cells = np.array(value, dtype=np.int64).reshape(-1, 2)
@@ -211,7 +242,7 @@ def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = N
     UnknownShapeError
         If a roadmap configuration names an unknown shape.
     """
-    if "width" in data or "robots" in data:
+    if "grid" not in data and "map" not in data and ("width" in data or "robots" in data):
         return _parse_continuous(data, where=where, base=base)
     unknown = set(data) - _GRID_KEYS
     if unknown:
@@ -232,35 +263,42 @@ def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = N
         if not map_path.is_absolute() and base is not None:
             map_path = base / map_path
         occ, cell_size = load_ros_map(map_path, cell_size=None if cell_size is None else float(cell_size))
+    if not isinstance(description, str):
+        raise ScenarioError(f"{where}: 'description' must be a string")
     moving = []
-    for i, entry in enumerate(data.get("moving", []), start=1):
+    for i, entry in enumerate(_array(data, "moving", where, tables=True), start=1):
         at = f"{where}: moving[{i}]"
         if not isinstance(entry, dict):
-            raise ScenarioError(f"{at}: expected a table")
+            raise ScenarioError(f"{at}: expected a table with cells, route, speed and mode")
         extra = set(entry) - {"cells", "route", "speed", "mode"}
         if extra:
             raise ScenarioError(f"{at}: unknown key(s) {', '.join(sorted(extra))}")
         cells = _cells(_require(entry, "cells", list, at), f"{at}: cells")
         route = _cells(entry.get("route", [[0, 0]]), f"{at}: route")
-        obstacle = MovingObstacle(cells, route, speed=entry.get("speed", 1), mode=entry.get("mode", "pingpong"))
+        try:
+            obstacle = MovingObstacle(cells, route, speed=entry.get("speed", 1), mode=entry.get("mode", "pingpong"))
+        except ScenarioError as err:
+            raise ScenarioError(f"{at}: {err}") from err
         _check_route(obstacle, occ, at)
         moving.append(obstacle)
-    hidden = _cells(data.get("hidden", []), f"{where}: hidden")
+    hidden = _cells(_array(data, "hidden", where), f"{where}: hidden")
     h, w = occ.shape
     for x, y in hidden.tolist():
         if not (0 <= x < w and 0 <= y < h):
             raise ScenarioError(f"{where}: hidden obstacle ({x}, {y}) lies outside the {w} x {h} map")
-    entries = data.get("roadmap", [])
-    if not isinstance(entries, list):
-        raise ScenarioError(f"{where}: 'roadmap' must be an array of tables ([[roadmap]])")
+    entries = _array(data, "roadmap", where, tables=True)
     workspace = Workspace(occ, cell_size, tuple(moving))
     roadmap = []
     for i, entry in enumerate(entries, start=1):
         at = f"{where}: roadmap[{i}]" + (" (start)" if i == 1 else " (goal)" if i == len(entries) else "")
         pose = _pose(entry, at)
         _check_pose_on_map(pose, workspace.occupancy_at(0) if i == 1 else occ, at)
+        if i == 1 and len(hidden):
+            revealed = occ.copy()
+            revealed[hidden[:, 1], hidden[:, 0]] = True
+            _check_pose_on_map(pose, revealed, f"{at} (against the hidden obstacles)")
         roadmap.append(pose)
-    return Scenario(name, source, workspace, tuple(roadmap), str(description), hidden, base)
+    return Scenario(name, source, workspace, tuple(roadmap), description, hidden, base)
 
 
 def _parse_continuous(data: dict, *, where: str, base: Path | None) -> ContinuousScenario:
@@ -269,43 +307,57 @@ def _parse_continuous(data: dict, *, where: str, base: Path | None) -> Continuou
         raise ScenarioError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
     name = _require(data, "name", str, where)
     source = _require(data, "source", str, where)
-    width = float(_require(data, "width", (int, float), where))
-    height = float(_require(data, "height", (int, float), where))
-    radius = float(data.get("robot_radius", 0.0))
-    if not (width > 0 and height > 0 and radius >= 0 and math.isfinite(width * height * radius)):
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        raise ScenarioError(f"{where}: 'description' must be a string")
+    width = _number(data, "width", where)
+    height = _number(data, "height", where)
+    radius = _number(data, "robot_radius", where, default=0.0)
+    if not (width > 0 and height > 0 and radius >= 0):
         raise ScenarioError(f"{where}: width and height must be positive and robot_radius >= 0")
     obstacles = []
-    for i, item in enumerate(data.get("obstacles", []), start=1):
+    for i, item in enumerate(_array(data, "obstacles", where), start=1):
+        at = f"{where}: obstacles[{i}]"
         try:
             arr = np.array(item, dtype=float)
         except (TypeError, ValueError) as err:
-            raise ScenarioError(f"{where}: obstacles[{i}] is neither a rectangle nor a polygon") from err
+            raise ScenarioError(f"{at}: expected [xmin, ymin, xmax, ymax] or a list of [x, y] points") from err
         if arr.shape == (4,):
             x0, y0, x1, y1 = arr
             if not (x0 < x1 and y0 < y1):
-                raise ScenarioError(f"{where}: obstacles[{i}] rectangle needs xmin < xmax and ymin < ymax")
+                raise ScenarioError(f"{at}: rectangle needs xmin < xmax and ymin < ymax")
             arr = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
         elif arr.ndim != 2 or arr.shape[1] != 2 or len(arr) < 3:
-            raise ScenarioError(f"{where}: obstacles[{i}] must be [xmin, ymin, xmax, ymax] or >= 3 [x, y] points")
+            raise ScenarioError(f"{at}: expected [xmin, ymin, xmax, ymax] or at least 3 [x, y] points")
+        if not np.isfinite(arr).all():
+            raise ScenarioError(f"{at}: coordinates must be finite numbers")
         obstacles.append(arr)
-    robots = _require(data, "robots", list, where)
+    robots = _array(data, "robots", where, tables=True)
     if not robots:
-        raise ScenarioError(f"{where}: 'robots' needs at least one robot")
+        raise ScenarioError(f"{where}: 'robots' needs at least one robot ([[robots]] with start and goal)")
     starts, goals = [], []
     for i, robot in enumerate(robots, start=1):
         at = f"{where}: robots[{i}]"
         if not isinstance(robot, dict) or set(robot) - {"start", "goal"}:
             raise ScenarioError(f"{at}: expected a table with 'start' and 'goal'")
         for key, out in (("start", starts), ("goal", goals)):
-            point = np.array(_require(robot, key, list, at), dtype=float)
-            if point.shape != (2,):
-                raise ScenarioError(f"{at}: {key} must be [x, y]")
-            if not (0 <= point[0] <= width and 0 <= point[1] <= height):
-                raise ConfigurationError(f"{at}: {key} {point.tolist()} lies outside the {width} x {height} workspace")
+            value = _require(robot, key, list, at)
+            try:
+                point = np.array(value, dtype=float)
+            except (TypeError, ValueError) as err:
+                raise ScenarioError(f"{at}: {key} must be [x, y] numbers, got {value!r}") from err
+            if point.shape != (2,) or not np.isfinite(point).all():
+                raise ScenarioError(f"{at}: {key} must be [x, y] numbers, got {value!r}")
+            if not (radius <= point[0] <= width - radius and radius <= point[1] <= height - radius):
+                raise ConfigurationError(
+                    f"{at}: {key} {point.tolist()} (radius {radius:g}) lies outside the {width:g} x {height:g} workspace"
+                )
+            for j, polygon in enumerate(obstacles, start=1):
+                if _point_in_obstacle(point, polygon, radius):
+                    raise ConfigurationError(f"{at}: {key} {point.tolist()} collides with obstacles[{j}] (radius {radius:g})")
             out.append(point)
     return ContinuousScenario(
-        name, source, width, height, tuple(obstacles), radius, np.array(starts), np.array(goals),
-        str(data.get("description", "")), base,
+        name, source, width, height, tuple(obstacles), radius, np.array(starts), np.array(goals), description, base,
     )
 
 
@@ -327,5 +379,5 @@ def load_scenario_file(path: str | Path) -> Scenario | ContinuousScenario:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
-        raise ScenarioError(f"{path}: malformed TOML: {err}") from err
+        raise ScenarioError(f"{path}: malformed TOML: {' '.join(str(err).split())}") from err
     return parse_scenario(data, where=str(path.name), base=path.parent)

@@ -5,7 +5,8 @@ honoured as map_server does in trinary mode: a pixel of value v (max value m) ha
 probability p = (m − v) / m (p = v / m when ``negate``); p > occupied_thresh is an obstacle,
 p < free_thresh is free, anything between is unknown and treated as an obstacle. Image rows are top
 first and are flipped so that row 0 is the bottom row. When a cell size larger than the resolution is
-asked for, each cell gathers ``cell_size / resolution`` pixels a side and is free only if all are.
+asked for, each cell gathers ``cell_size / resolution`` pixels a side and is free only if all are; the
+image is padded with blocked pixels to whole cells (row 0 stays the image's bottom row).
 """
 
 from __future__ import annotations
@@ -104,11 +105,16 @@ def load_ros_map(yaml_path: str | Path, *, cell_size: float | None = None) -> tu
     """
     yaml_path = Path(yaml_path)
     try:
-        meta = yaml.safe_load(yaml_path.read_text())
+        meta = yaml.safe_load(yaml_path.read_text(encoding="utf-8"))
     except OSError as err:
         raise ScenarioError(f"{yaml_path}: cannot read map: {err.strerror or err}") from err
+    except UnicodeDecodeError as err:
+        raise ScenarioError(f"{yaml_path}: not a text YAML file (give the map's .yaml, not its image)") from err
     except yaml.YAMLError as err:
-        raise ScenarioError(f"{yaml_path}: malformed YAML: {err}") from err
+        mark = getattr(err, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        problem = getattr(err, "problem", None) or "cannot parse"
+        raise ScenarioError(f"{yaml_path}: malformed YAML{where}: {problem}") from err
     if not isinstance(meta, dict):
         raise ScenarioError(f"{yaml_path}: a map YAML must be a mapping")
     for key in ("image", "resolution"):
@@ -137,8 +143,8 @@ def load_ros_map(yaml_path: str | Path, *, cell_size: float | None = None) -> tu
         raise ScenarioError(
             f"{yaml_path}: cell size {cell_size} m is not a whole multiple of the resolution {resolution} m"
         )
-    h, w = blocked.shape[0] // n, blocked.shape[1] // n
-    if h == 0 or w == 0:
-        raise ScenarioError(f"{yaml_path}: map smaller than one {cell_size} m cell")
-    cells = blocked[: h * n, : w * n].reshape(h, n, w, n).any(axis=(1, 3))
-    return cells, float(cell_size)
+    # Pad to whole cells with blocked pixels: a cell partly off the image is not known to be free.
+    h, w = -(-blocked.shape[0] // n), -(-blocked.shape[1] // n)
+    padded = np.ones((h * n, w * n), dtype=bool)
+    padded[: blocked.shape[0], : blocked.shape[1]] = blocked
+    return padded.reshape(h, n, w, n).any(axis=(1, 3)), float(cell_size)

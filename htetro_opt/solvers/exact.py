@@ -4,7 +4,8 @@ The search graph is the :class:`~htetro_opt.model.Simulator`'s own transition ta
 pose, one edge per valid command weighted by its duration, so every plan re-validates in the
 simulator by construction. With moving obstacles the graph is time-expanded over their period
 (node = pose × time modulo the period; the obstacles' time is the number of commands executed, as in
-the simulator). A roadmap is planned leg by leg, each leg starting where and when the previous one
+the simulator), and a command that leaves the pose unchanged (``stop``, a shapeshift to the current
+shape) is a way to wait. A roadmap is planned leg by leg, each leg starting where and when the previous one
 ended (seed 000's configuration loop); each leg is time-optimal.
 
 Two algorithms give the same optimum: ``"dijkstra"`` (scipy.sparse.csgraph over the whole graph, the
@@ -72,58 +73,80 @@ class Plan:
 
 
 class _Graph:
-    """Edges of a simulator's transition table, per obstacle phase, built on demand."""
+    """The simulator's transition table as a (time-expanded) CSR graph, cheapest command per edge."""
 
     def __init__(self, sim: Simulator) -> None:
         self.sim = sim
         n, c = sim.n_poses, sim.n_commands
-        target = sim.next[:n, :c].astype(np.int64)
-        source = np.broadcast_to(np.arange(n)[:, None], target.shape)
-        column = np.broadcast_to(np.arange(c)[None, :], target.shape)
-        keep = (target != sim.dead) & (target != source)
-        self.source, self.target, self.column = source[keep], target[keep], column[keep]
-        self.weight = sim.durations[self.column]
-        if (self.weight <= 0).any():
+        self.target = sim.next[:n, :c]
+        usable = self.target != sim.dead
+        if not sim.workspace.moving:
+            # A command that leaves the pose unchanged is useless on a static map; with moving
+            # obstacles it is a wait, which advances their clock.
+            usable &= self.target != np.arange(n, dtype=self.target.dtype)[:, None]
+        for cheap, costly in self._colliding_columns():
+            usable[:, costly] &= ~(usable[:, cheap] & (self.target[:, cheap] == self.target[:, costly]))
+        self.usable = usable
+        if (sim.durations[:c] <= 0).any() and usable[:, sim.durations[:c] <= 0].any():
             raise PlanningError("exact planning needs every command that moves the robot to take a positive time")
-        self._phases: dict[int, csr_matrix] = {}
+        self._matrix: csr_matrix | None = None
 
-    def edges(self, phase: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(source, target, column, weight) of the edges usable at time ``phase``."""
+    def _colliding_columns(self) -> list[tuple[int, int]]:
+        """Pairs (cheaper, costlier) of local commands that lead some pose to the same next pose."""
+        sim, t = self.sim, self.sim.tables
+        ids, states = sim.command_ids, slice(0, sim.n_states)
+        pairs = []
+        for i in range(len(ids)):
+            for j in range(i + 1, len(ids)):
+                a, b = ids[i], ids[j]
+                if (t.shift[a] != t.shift[b]).any() or (t.next_heading[states, :, a] != t.next_heading[states, :, b]).any():
+                    continue
+                both = t.legal[states, a] & t.legal[states, b]
+                if (t.next_state[states, a][both] == t.next_state[states, b][both]).any():
+                    cheap, costly = (i, j) if sim.durations[i] <= sim.durations[j] else (j, i)
+                    pairs.append((cheap, costly))
+        return pairs
+
+    def _usable_at(self, phase: int) -> np.ndarray:
         if not self.sim.workspace.moving:
-            return self.source, self.target, self.column, self.weight
-        blocked = self.sim.blocked_keys(phase)
-        keys = self.source * self.sim.n_columns + self.column
-        ok = ~np.isin(keys, blocked, assume_unique=False)
-        return self.source[ok], self.target[ok], self.column[ok], self.weight[ok]
+            return self.usable
+        keys = self.sim.blocked_keys(phase)
+        usable = self.usable.copy()
+        columns = self.sim.n_columns
+        usable[keys // columns, keys % columns] = False
+        return usable
 
     def matrix(self) -> csr_matrix:
-        """The whole (time-expanded when moving) graph as a CSR matrix, cheapest edge per node pair."""
-        period, n = self.sim.workspace.period, self.sim.n_poses
-        if 0 not in self._phases:
-            rows, cols, weights = [], [], []
+        """The whole graph: node = phase * n_poses + pose, one edge per usable (pose, command)."""
+        if self._matrix is None:
+            sim = self.sim
+            period, n = sim.workspace.period, sim.n_poses
+            weights = np.broadcast_to(sim.durations[: sim.n_commands], self.target.shape)
+            indptr, indices, data = [np.zeros(1, dtype=np.int64)], [], []
             for phase in range(period):
-                s, t, _, w = self.edges(phase)
-                rows.append(s + phase * n)
-                cols.append(t + ((phase + 1) % period) * n)
-                weights.append(w)
-            r, c, w = np.concatenate(rows), np.concatenate(cols), np.concatenate(weights)
-            order = np.lexsort((w, r * (n * period) + c))
-            r, c, w = r[order], c[order], w[order]
-            first = np.ones(len(r), dtype=bool)
-            first[1:] = (r[1:] != r[:-1]) | (c[1:] != c[:-1])
-            size = n * period
-            self._phases[0] = csr_matrix((w[first], (r[first], c[first])), shape=(size, size))
-        return self._phases[0]
+                usable = self._usable_at(phase)
+                indptr.append(indptr[-1][-1] + np.cumsum(usable.sum(axis=1)))
+                indices.append(self.target[usable].astype(np.int64) + ((phase + 1) % period) * n)
+                data.append(weights[usable])
+            self._matrix = csr_matrix(
+                (np.concatenate(data), np.concatenate(indices), np.concatenate(indptr)),
+                shape=(n * period, n * period),
+            )
+        return self._matrix
 
     def step_command(self, u: int, v: int, phase: int) -> int:
         """Local command of the cheapest usable edge u → v at time ``phase``."""
-        sim = self.sim
-        row = sim.next[u, : sim.n_commands]
-        candidates = np.flatnonzero(row == v)
-        if sim.workspace.moving:
-            blocked = sim.blocked_keys(phase)
-            candidates = candidates[~np.isin(u * sim.n_columns + candidates, blocked)]
-        return int(candidates[np.argmin(sim.durations[candidates])])
+        candidates = np.flatnonzero((self.target[u] == v) & self._usable_row(u, phase))
+        return int(candidates[np.argmin(self.sim.durations[candidates])])
+
+    def _usable_row(self, u: int, phase: int) -> np.ndarray:
+        row = self.usable[u].copy()
+        if self.sim.workspace.moving:
+            keys = self.sim.blocked_keys(phase)
+            columns = self.sim.n_columns
+            mine = keys[(keys // columns) == u] % columns
+            row[mine] = False
+        return row
 
 
 def _dijkstra_leg(graph: _Graph, start: int, goal: int, t0: int) -> list[int] | None:
@@ -165,17 +188,12 @@ def _astar_leg(graph: _Graph, start: int, goal: int, t0: int, heuristic: np.ndar
                 node, column = parent[node]
                 commands.append(column)
             return commands[::-1]
-        row = sim.next[pose, : sim.n_commands].tolist()
-        blocked = sim.blocked_keys(phase) if moving else None
+        row = graph.target[pose].tolist()
+        usable = (graph._usable_row(pose, phase) if moving else graph.usable[pose]).tolist()
         next_phase = (phase + 1) % period
         for column, target in enumerate(row):
-            if target == sim.dead or target == pose:
+            if not usable[column]:
                 continue
-            if blocked is not None and len(blocked):
-                key = pose * sim.n_columns + column
-                at = np.searchsorted(blocked, key)
-                if at < len(blocked) and blocked[at] == key:
-                    continue
             cost = g + durations[column]
             child = next_phase * n + target
             if cost < best.get(child, math.inf):

@@ -66,9 +66,9 @@ def plot_path(
 
     poses = np.asarray(poses, dtype=int).reshape(-1, 4)
     if ax is None:
-        side = 7.0
+        side = 6.0
         aspect = workspace.height / workspace.width
-        fig, ax = plt.subplots(figsize=(side, max(3.0, side * aspect) + 0.6), constrained_layout=True)
+        fig, ax = plt.subplots(figsize=(side + 1.6, max(2.5, side * aspect) + 0.7), constrained_layout=True)
     else:
         fig = ax.figure
     w, h = workspace.width, workspace.height

@@ -1,0 +1,221 @@
+"""The vectorised simulator against a plain per-command reference, and its invariants."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from htetro_opt.errors import ConfigurationError, UnknownCommandError
+from htetro_opt.model import (
+    COMMANDS,
+    MovingObstacle,
+    Pose,
+    Simulator,
+    Timing,
+    Workspace,
+    command_id,
+    parse_commands,
+    simulate,
+    sweep_tables,
+)
+from htetro_opt.model.robot import STATE_NAMES, shape_index
+
+ALL_TOKENS = [c.token for c in COMMANDS]
+
+
+def reference_run(workspace, tokens, start, *, roadmap=(), clearance=0.0, timing=Timing()):
+    """Execute one sequence command by command from the swept-cell table: the obvious algorithm."""
+    tables = sweep_tables(clearance)
+    x, y, s, h = start.x, start.y, shape_index(start.shape), start.heading
+    goals = [(p.x, p.y, shape_index(p.shape), p.heading) for p in roadmap]
+    progress, total = 0, 0.0
+    for t, token in enumerate(tokens):
+        c = command_id(token)
+        if not tables.legal[s, c]:
+            return False, t, (x, y, s, h), total, progress
+        occ = workspace.occupancy | workspace.moving_during(t) if workspace.moving else workspace.occupancy
+        for ox, oy in tables.cells(s, h, c):
+            cx, cy = x + ox, y + oy
+            if not (0 <= cx < workspace.width and 0 <= cy < workspace.height) or occ[cy, cx]:
+                return False, t, (x, y, s, h), total, progress
+        x, y = x + tables.shift[c][0], y + tables.shift[c][1]
+        s, h = tables.next_state[s, c], tables.next_heading[s, h, c]
+        total += timing.duration(token)
+        if progress < len(goals) and (x, y, s, h) == goals[progress]:
+            progress += 1
+    return True, -1, (x, y, s, h), total, progress
+
+
+def random_map(rng, w, h, density):
+    occ = rng.random((h, w)) < density
+    occ[:, :4] = False  # keep a free strip for the start (and its clearance)
+    return occ
+
+
+@pytest.mark.parametrize("clearance", [0.0, 0.3])
+def test_batch_matches_reference_on_random_sequences(clearance):
+    rng = np.random.default_rng(7)
+    ws = Workspace(random_map(rng, 14, 12, 0.12))
+    start = Pose(1, 5, "I", 0)
+    sim = Simulator(ws, commands=ALL_TOKENS, clearance=clearance)
+    tokens = [list(rng.choice(ALL_TOKENS, size=rng.integers(0, 40))) for _ in range(300)]
+    result = sim.run([parse_commands(t) for t in tokens], start)
+    for i, seq in enumerate(tokens):
+        valid, first, final, total, _ = reference_run(ws, seq, start, clearance=clearance)
+        assert result.valid[i] == valid
+        assert result.first_invalid[i] == first
+        assert tuple(result.final[i]) == final
+        assert result.time[i] == pytest.approx(total)
+        assert result.executed[i] == (first if first >= 0 else len(seq))
+    assert 0 < result.valid.sum() < len(tokens)  # the sample exercises both outcomes
+
+
+def test_moving_obstacles_match_reference():
+    rng = np.random.default_rng(3)
+    occ = np.zeros((10, 10), dtype=bool)
+    moving = (
+        MovingObstacle(np.array([[5, 2], [5, 3]]), np.array([[0, 0], [0, 5]])),
+        MovingObstacle(np.array([[2, 8]]), np.array([[6, 0]]), mode="loop", speed=2),
+    )
+    ws = Workspace(occ, moving=moving)
+    start = Pose(1, 1, "O", 0)
+    sim = Simulator(ws)
+    tokens = [list(rng.choice(["x+", "x-", "y+", "y-", "r+", "sI", "sO"], size=30)) for _ in range(300)]
+    result = sim.run([parse_commands(t) for t in tokens], start)
+    blocked_by_moving = 0
+    static = Simulator(ws.without_moving()).run([parse_commands(t) for t in tokens], start)
+    for i, seq in enumerate(tokens):
+        valid, first, final, total, _ = reference_run(ws, seq, start)
+        assert (result.valid[i], result.first_invalid[i], tuple(result.final[i])) == (valid, first, final)
+        blocked_by_moving += int(static.executed[i] > result.executed[i])
+    assert blocked_by_moving > 0
+
+
+def test_roadmap_progress_and_stop_at_goal():
+    ws = Workspace(np.zeros((8, 8), dtype=bool))
+    start, mid, goal = Pose(1, 1, "O", 0), Pose(3, 1, "O", 0), Pose(3, 3, "O", 0)
+    seqs = [
+        parse_commands("x+,x+,y+,y+"),  # through mid, ends on goal
+        parse_commands("y+,y+,x+,x+"),  # ends on goal but skips mid
+        parse_commands("x+,x+,y+,y+,x+"),  # passes goal, moves on
+        parse_commands("x+,x+,y+"),  # stops short
+    ]
+    r = Simulator(ws).run(seqs, start, roadmap=[mid, goal])
+    assert r.reached.tolist() == [True, False, False, False]
+    assert r.progress.tolist() == [3, 1, 3, 2]
+    r = Simulator(ws).run(seqs, start, roadmap=[mid, goal], stop_at_goal=True)
+    assert r.reached.tolist() == [True, False, True, False]
+    assert r.executed.tolist() == [4, 4, 4, 3]
+    assert r.poses(2)[-1].tolist() == [3, 3, shape_index("O"), 0]
+
+
+def test_poses_and_time_of_a_known_sequence():
+    ws = Workspace(np.zeros((8, 8), dtype=bool))
+    r = simulate(ws, [parse_commands("sI,x+,r+,y+")], Pose(3, 3, "O", 0))
+    assert r.poses(0).tolist() == [[3, 3, 1, 0], [3, 3, 0, 0], [4, 3, 0, 0], [4, 3, 0, 1], [4, 4, 0, 1]]
+    assert r.time[0] == 3.0 + 1.0 + 2.0 + 1.0
+    assert r.final_pose(0) == Pose(4, 4, "I", 1)
+
+
+def test_empty_sequences_and_empty_batch():
+    ws = Workspace(np.zeros((5, 5), dtype=bool))
+    r = simulate(ws, [np.array([], dtype=int)] * 2, Pose(1, 1, "O", 0))
+    assert r.valid.all() and (r.executed == 0).all() and (r.time == 0).all()
+    assert len(simulate(ws, [], Pose(1, 1, "O", 0))) == 0
+
+
+def test_errors():
+    ws = Workspace(np.zeros((5, 5), dtype=bool))
+    sim = Simulator(ws)
+    with pytest.raises(ConfigurationError, match="start"):
+        sim.run([parse_commands("x+")], Pose(4, 4, "O", 0))  # a block outside the map
+    with pytest.raises(UnknownCommandError, match="x\\+y\\+"):
+        sim.run([parse_commands("x+y+")], Pose(1, 1, "O", 0))  # diagonals not enabled
+    with pytest.raises(UnknownCommandError, match="'jump' at position 2"):
+        parse_commands("x+, jump")
+
+
+# --- property tests ----------------------------------------------------------------------------
+
+def turn_token(token, quarter_turns):
+    """The token that does in a map turned by 90°·k what ``token`` does in the original."""
+    cmd = COMMANDS[command_id(token)]
+    if cmd.kind not in ("translation", "diagonal"):
+        return token
+    dx, dy = cmd.shift
+    for _ in range(quarter_turns % 4):
+        dx, dy = -dy, dx
+    parts = ("x+" if dx > 0 else "x-" if dx < 0 else "") + ("y+" if dy > 0 else "y-" if dy < 0 else "")
+    return parts
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 10_000),
+    tokens=st.lists(st.sampled_from(ALL_TOKENS), min_size=0, max_size=25),
+    quarter_turns=st.integers(1, 3),
+)
+def test_turning_the_whole_world_turns_the_outcome(seed, tokens, quarter_turns):
+    """Simulation commutes with turning the map, the start heading and every translation."""
+    rng = np.random.default_rng(seed)
+    n = 11
+    occ = rng.random((n, n)) < 0.1
+    centre = (5, 5)
+    occ[3:8, 3:8] = False
+    start = Pose(5, 5, STATE_NAMES[rng.integers(0, 7)], int(rng.integers(0, 4)))
+
+    def turn_cell(x, y, k):
+        for _ in range(k % 4):  # about the map's centre cell
+            x, y = centre[0] - (y - centre[1]), centre[1] + (x - centre[0])
+        return x, y
+
+    turned_occ = np.zeros_like(occ)
+    for y in range(n):
+        for x in range(n):
+            tx, ty = turn_cell(x, y, quarter_turns)
+            turned_occ[ty, tx] = occ[y, x]
+    a = Simulator(Workspace(occ), commands=ALL_TOKENS)
+    b = Simulator(Workspace(turned_occ), commands=ALL_TOKENS)
+    try:
+        ra = a.run([parse_commands(tokens)], start)
+    except ConfigurationError:
+        return  # start collides: nothing to compare
+    turned_start = Pose(5, 5, start.shape, (start.heading + quarter_turns) % 4)
+    rb = b.run([parse_commands([turn_token(t, quarter_turns) for t in tokens])], turned_start)
+    assert ra.valid[0] == rb.valid[0] and ra.executed[0] == rb.executed[0]
+    x, y, s, h = ra.final[0]
+    assert tuple(rb.final[0]) == (*turn_cell(x, y, quarter_turns), s, (h + quarter_turns) % 4)
+    assert ra.time[0] == rb.time[0]
+
+
+@settings(max_examples=60, deadline=None)
+@given(shape=st.sampled_from(STATE_NAMES[:7]), heading=st.integers(0, 3),
+       target=st.sampled_from(STATE_NAMES[:7]), turns=st.integers(0, 4))
+def test_rotation_and_shapeshift_invariants(shape, heading, target, turns):
+    """r+ then r− and sX then back are identities; four r+ are a full turn; B2's cell never moves."""
+    ws = Workspace(np.zeros((13, 13), dtype=bool))
+    start = Pose(6, 6, shape, heading)
+    seqs = [
+        parse_commands(["r+", "r-"]),
+        parse_commands(["r+"] * 4),
+        parse_commands(["s" + target, "s" + shape]),
+        parse_commands(["r+"] * turns + ["s" + target] + ["r-"] * turns),
+    ]
+    r = Simulator(ws).run(seqs, start)
+    assert r.valid.all()
+    for i in range(3):
+        assert tuple(r.final[i]) == (6, 6, shape_index(shape), heading)
+    assert tuple(r.final[3]) == (6, 6, shape_index(target), heading)
+    assert (r.trace[:, :][:, :1] == r.trace[:, :1]).all()
+    for i in range(len(seqs)):
+        assert (r.poses(i)[:, :2] == (6, 6)).all()
+
+
+@settings(max_examples=40, deadline=None)
+@given(tokens=st.lists(st.sampled_from(["x+", "x-", "y+", "y-", "x+y+", "x-y-", "x+y-", "x-y+"]), max_size=30))
+def test_translations_keep_shape_and_heading_and_add_up(tokens):
+    ws = Workspace(np.zeros((70, 70), dtype=bool))
+    r = Simulator(ws, diagonals=True).run([parse_commands(tokens)], Pose(35, 35, "T", 2))
+    shift = np.sum([COMMANDS[command_id(t)].shift for t in tokens] or [[0, 0]], axis=0)
+    assert r.valid[0]
+    assert tuple(r.final[0]) == (35 + shift[0], 35 + shift[1], shape_index("T"), 2)

@@ -1,0 +1,358 @@
+"""Tests of the htetro-opt command line: plan, simulate, scenarios, plots and error reporting."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from htetro_opt.cli import main
+from htetro_opt.scenarios import list_scenarios
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+# 10 x 9 map: an 8 x 7 free room (x 1..8, y 1..7) inside a wall ring.
+ROOM = """\
+##########
+#........#
+#........#
+#........#
+#........#
+#........#
+#........#
+#........#
+##########"""
+
+# Two 6 x 6 rooms separated by a solid wall: nothing in the left room reaches the right one.
+TWO_ROOMS = """\
+###############
+#......#......#
+#......#......#
+#......#......#
+#......#......#
+#......#......#
+#......#......#
+###############"""
+
+
+def pose(x, y, shape, heading=0) -> str:
+    return f'[[roadmap]]\nx = {x}\ny = {y}\nshape = "{shape}"\nheading = {heading}\n'
+
+
+def scenario(path: Path, grid: str = ROOM, roadmap: str = "", name: str | None = None, extra: str = "") -> str:
+    name = name or path.stem
+    path.write_text(f'name = "{name}"\nsource = "test"\n{extra}\ngrid = """\n{grid}\n"""\n{roadmap}')
+    return str(path)
+
+
+def run(capsys, argv):
+    """main(argv) -> (exit code, stdout, stderr)."""
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def run_json(capsys, argv):
+    code, out, err = run(capsys, argv)
+    assert code == 0, err
+    assert err == ""
+    lines = out.strip().splitlines()
+    assert len(lines) == 1, out  # exactly one JSON object on one line
+    return json.loads(lines[0])
+
+
+def assert_one_error_line(code, out, err, *words):
+    assert code == 2
+    assert out == ""
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("error: ")
+    assert "Traceback" not in err
+    for word in words:
+        assert word in lines[0], (word, lines[0])
+
+
+@pytest.fixture(scope="module")
+def room(tmp_path_factory) -> str:
+    """Start O at (2, 2) heading 0; goal I lying along x (heading 1) at (6, 5)."""
+    path = tmp_path_factory.mktemp("cli") / "room.toml"
+    return scenario(path, roadmap=pose(2, 2, "O") + pose(6, 5, "I", 1))
+
+
+@pytest.fixture(scope="module")
+def plan_out(room):
+    import io
+    from contextlib import redirect_stderr, redirect_stdout
+
+    out, err = io.StringIO(), io.StringIO()
+    with redirect_stdout(out), redirect_stderr(err):
+        code = main(["plan", room, "--json"])
+    assert code == 0 and err.getvalue() == ""
+    lines = out.getvalue().strip().splitlines()
+    assert len(lines) == 1
+    return json.loads(lines[0])
+
+
+@pytest.fixture
+def near(tmp_path) -> str:
+    """Start O at (2, 2), goal O at (4, 2): two x+ apart."""
+    return scenario(tmp_path / "near.toml", roadmap=pose(2, 2, "O") + pose(4, 2, "O"))
+
+
+# --------------------------------------------------------------------------------------------------
+# plan
+
+
+def test_plan_json_keys_and_optimal_time(plan_out):
+    assert set(plan_out) == {"scenario", "method", "reached", "commands", "time", "objectives", "runtime_s"}
+    assert plan_out["scenario"] == "room"
+    assert plan_out["method"] == "exact"
+    assert plan_out["reached"] is True
+    assert isinstance(plan_out["commands"], list) and all(isinstance(t, str) for t in plan_out["commands"])
+    # Lower bound: 7 unit translations (Manhattan distance of B2), one rotation (2.0: the goal heading
+    # differs and a shapeshift keeps the heading) and one shapeshift O -> I (3.0).
+    assert plan_out["time"] == pytest.approx(12.0)
+    assert sorted(plan_out["commands"]).count("sI") == 1
+    assert isinstance(plan_out["objectives"], dict) and plan_out["objectives"]
+    assert isinstance(plan_out["runtime_s"], float) and plan_out["runtime_s"] >= 0
+
+
+def test_plan_astar_gives_the_same_time(capsys, room, plan_out):
+    astar = run_json(capsys, ["plan", room, "--method", "astar", "--json"])
+    assert astar["method"] == "astar"
+    assert astar["reached"] is True
+    assert astar["time"] == pytest.approx(plan_out["time"])
+
+
+def test_plan_commands_replay_in_simulate(capsys, room, plan_out):
+    sim = run_json(capsys, ["simulate", room, "--commands", ",".join(plan_out["commands"]), "--json"])
+    assert sim["valid"] is True
+    assert sim["reached"] is True
+    assert sim["executed"] == len(plan_out["commands"])
+    assert sim["time"] == pytest.approx(plan_out["time"])
+    assert sim["final"] == {"x": 6, "y": 5, "shape": "I", "heading": 1}
+
+
+def test_plan_unreachable_goal_is_not_a_crash(capsys, tmp_path):
+    path = scenario(tmp_path / "apart.toml", grid=TWO_ROOMS, roadmap=pose(2, 2, "O") + pose(10, 3, "O"))
+    out = run_json(capsys, ["plan", path, "--json"])
+    assert out["reached"] is False
+    assert out["scenario"] == "apart"
+
+
+def test_plan_text_output_and_plot(capsys, tmp_path, near):
+    png = tmp_path / "plan.png"
+    code, out, err = run(capsys, ["plan", near, "--plot", str(png)])
+    assert code == 0 and err == ""
+    lines = out.strip().splitlines()
+    assert len(lines) == 2
+    assert "reached" in lines[0] and "NOT" not in lines[0]
+    assert lines[1].split() == ["x+", "x+"]
+    assert png.read_bytes()[:8] == PNG_SIGNATURE
+    assert png.stat().st_size > 1000
+
+
+# --------------------------------------------------------------------------------------------------
+# simulate
+
+
+def test_simulate_json_keys_and_reached(capsys, near):
+    out = run_json(capsys, ["simulate", near, "--commands", "x+,x+", "--json"])
+    assert {"valid", "reached", "executed", "final", "time"} <= set(out)
+    assert out["valid"] is True and out["reached"] is True
+    assert out["executed"] == 2
+    assert out["final"] == {"x": 4, "y": 2, "shape": "O", "heading": 0}
+    assert out["time"] == pytest.approx(2.0)
+
+
+def test_simulate_passing_the_goal_is_not_reaching_it(capsys, near):
+    out = run_json(capsys, ["simulate", near, "--commands", "x+ x+ x+", "--json"])
+    assert out["valid"] is True and out["reached"] is False
+    assert out["final"]["x"] == 5
+    back = run_json(capsys, ["simulate", near, "--commands", "x+ x+ x+ x-", "--json"])
+    assert back["reached"] is True and back["time"] == pytest.approx(4.0)
+
+
+def test_simulate_rotation_and_shapeshift_times(capsys, room):
+    out = run_json(capsys, ["simulate", room, "--commands", "x+ x+ y+ y+ r+ sI", "--json"])
+    assert out["valid"] is True
+    assert out["final"] == {"x": 4, "y": 4, "shape": "I", "heading": 1}
+    assert out["time"] == pytest.approx(4 * 1.0 + 2.0 + 3.0)
+    assert out["reached"] is False
+
+
+def test_simulate_executed_counts_commands_before_the_first_invalid(capsys, near):
+    # O at (2, 2) covers x 2..3; the room ends at x = 8, so the 6th x+ hits the wall.
+    out = run_json(capsys, ["simulate", near, "--commands", "x+ x+ x+ x+ x+ x+ y+ y+", "--json"])
+    assert out["valid"] is False
+    assert out["executed"] == 5
+    assert out["first_invalid"] == 5
+    assert out["final"] == {"x": 7, "y": 2, "shape": "O", "heading": 0}
+    assert out["time"] == pytest.approx(5.0)
+    assert out["reached"] is False
+
+
+def test_simulate_reached_needs_the_whole_sequence_valid(capsys, near):
+    # x+ x+ lands on the goal; the following y- puts B1 into the bottom wall and is not executed: the
+    # sequence as a whole is invalid, so it does not count as reaching the goal.
+    out = run_json(capsys, ["simulate", near, "--commands", "x+,x+,y-,y-", "--json"])
+    assert out["valid"] is False and out["executed"] == 2 and out["first_invalid"] == 2
+    assert out["final"] == {"x": 4, "y": 2, "shape": "O", "heading": 0}
+    assert out["reached"] is False
+    assert run_json(capsys, ["simulate", near, "--commands", "x+,x+", "--json"])["reached"] is True
+    assert out["time"] == pytest.approx(2.0)
+    # One valid step past the goal before the invalid command: the prefix no longer ends on it.
+    past = run_json(capsys, ["simulate", near, "--commands", "x+,x+,x+,y-", "--json"])
+    assert past["valid"] is False and past["executed"] == 3 and past["reached"] is False
+
+
+def test_simulate_empty_sequence(capsys, near):
+    out = run_json(capsys, ["simulate", near, "--commands", "", "--json"])
+    assert out["valid"] is True and out["executed"] == 0 and out["time"] == 0.0
+    assert out["final"] == {"x": 2, "y": 2, "shape": "O", "heading": 0}
+    assert out["reached"] is False
+
+
+def test_simulate_text_output(capsys, near):
+    code, out, err = run(capsys, ["simulate", near, "--commands", "x+ x+ x+ x+ x+ x+"])
+    assert code == 0 and err == ""
+    assert "INVALID at command 6" in out and "executed 5 of 6" in out
+
+
+def test_simulate_plot(capsys, tmp_path, near):
+    png = tmp_path / "sim.png"
+    out = run_json(capsys, ["simulate", near, "--commands", "x+ x+ x+ x+ x+ x+", "--json", "--plot", str(png)])
+    assert out["executed"] == 5
+    assert png.read_bytes()[:8] == PNG_SIGNATURE
+
+
+@pytest.mark.parametrize("command", [["plan"], ["simulate", "--commands", "x+"]])
+def test_plot_into_missing_directory(capsys, tmp_path, near, command):
+    target = tmp_path / "missing" / "out.png"
+    argv = [command[0], near, *command[1:], "--json", "--plot", str(target)]
+    code, out, err = run(capsys, argv)
+    assert_one_error_line(code, out, err, "missing")
+    assert not target.exists() and not target.parent.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["near.toml"]
+
+
+# --------------------------------------------------------------------------------------------------
+# scenarios
+
+
+def test_scenarios_json_lists_the_bundled_scenarios(capsys):
+    out = run_json(capsys, ["scenarios", "--json"])
+    assert [row["name"] for row in out["scenarios"]] == list_scenarios()
+
+
+def test_scenarios_text_lists_one_name_per_line(capsys):
+    code, out, err = run(capsys, ["scenarios"])
+    assert code == 0 and err == ""
+    names = [line.split()[0] for line in out.splitlines() if line.strip()]
+    assert names == list_scenarios()
+
+
+# --------------------------------------------------------------------------------------------------
+# errors: one "error: " line on stderr, nothing on stdout, exit 2
+
+
+def test_unknown_scenario_name(capsys):
+    assert_one_error_line(*run(capsys, ["plan", "no_such_scenario", "--json"]), "no_such_scenario")
+
+
+def test_malformed_toml(capsys, tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text('name = "bad"\nsource = \n')
+    assert_one_error_line(*run(capsys, ["plan", str(path), "--json"]), "bad.toml", "line 2")
+
+
+def test_ragged_grid(capsys, tmp_path):
+    grid = ROOM.replace("#........#\n##########", "#.......#\n##########")
+    path = scenario(tmp_path / "ragged.toml", grid=grid, roadmap=pose(2, 2, "O") + pose(4, 2, "O"))
+    assert_one_error_line(*run(capsys, ["plan", path]), "ragged.toml", "row 8", "ragged")
+
+
+def test_colliding_start(capsys, tmp_path):
+    # O at (8, 3): B3 and B4 at x = 9, the right wall.
+    path = scenario(tmp_path / "hit.toml", roadmap=pose(8, 3, "O") + pose(4, 2, "O"))
+    assert_one_error_line(*run(capsys, ["simulate", path, "--commands", "x+"]), "hit.toml", "roadmap[1]", "(9, 3)")
+
+
+def test_goal_outside_the_map(capsys, tmp_path):
+    # I lying along x at (1, 5): blocks (2, 5), (1, 5), (0, 5), (-1, 5).
+    path = scenario(tmp_path / "out.toml", roadmap=pose(2, 2, "O") + pose(1, 5, "I", 1))
+    assert_one_error_line(*run(capsys, ["plan", path]), "out.toml", "roadmap[2]", "outside", "(-1, 5)")
+
+
+def test_unknown_shape(capsys, tmp_path):
+    path = scenario(tmp_path / "shape.toml", roadmap=pose(2, 2, "O") + pose(4, 2, "X"))
+    assert_one_error_line(*run(capsys, ["plan", path, "--json"]), "'X'", "roadmap[2]")
+
+
+def test_unknown_command_token(capsys, near):
+    code, out, err = run(capsys, ["simulate", near, "--commands", "x+, y+ ,zz,x+", "--json"])
+    assert_one_error_line(code, out, err, "'zz'", "position 3")
+
+
+def test_plan_without_goal(capsys, tmp_path):
+    path = scenario(tmp_path / "lonely.toml", roadmap=pose(2, 2, "O"))
+    assert_one_error_line(*run(capsys, ["plan", path, "--json"]), "lonely", "goal")
+
+
+def test_simulate_without_start(capsys, tmp_path):
+    path = scenario(tmp_path / "empty.toml")
+    assert_one_error_line(*run(capsys, ["simulate", path, "--commands", "x+"]), "empty", "start")
+
+
+def test_plan_on_continuous_scenario(capsys, tmp_path):
+    path = tmp_path / "cont.toml"
+    path.write_text('name = "cont"\nsource = "t"\nwidth = 5\nheight = 5\n[[robots]]\nstart = [1, 1]\ngoal = [4, 4]\n')
+    assert_one_error_line(*run(capsys, ["plan", str(path)]), "continuous")
+
+
+@pytest.mark.parametrize("argv,words", [
+    ([], ["required"]),
+    (["plan"], ["required", "scenario"]),
+    (["simulate", "{near}"], ["required", "--commands"]),
+    (["plan", "{near}", "--bogus"], ["unrecognized", "--bogus"]),
+    (["frobnicate"], ["invalid choice", "frobnicate"]),
+    (["plan", "{near}", "--method", "genetic"], ["invalid choice", "genetic"]),
+    (["plan", "{near}", "--seed", "abc"], ["--seed", "abc"]),
+    (["plan", "{near}", "--clearance", "-1"], ["--clearance"]),
+    (["simulate", "{near}", "--commands", "x+", "--clearance", "nan"], ["--clearance"]),
+])
+def test_usage_errors(capsys, near, argv, words):
+    argv = [a.replace("{near}", near) for a in argv]
+    assert_one_error_line(*run(capsys, argv), *words)
+
+
+def test_malformed_map_yaml_is_one_error_line(capsys, tmp_path):
+    (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: [0.05\n")
+    path = tmp_path / "ros.toml"
+    path.write_text('name = "ros"\nsource = "t"\nmap = "m.yaml"\n')
+    assert_one_error_line(*run(capsys, ["simulate", str(path), "--commands", "x+"]), "m.yaml")
+
+
+def test_non_numeric_robot_radius_is_an_error_line(capsys, tmp_path):
+    path = tmp_path / "cont.toml"
+    path.write_text('name = "c"\nsource = "t"\nwidth = 5\nheight = 5\nrobot_radius = "big"\n'
+                    '[[robots]]\nstart = [1, 1]\ngoal = [4, 4]\n')
+    assert_one_error_line(*run(capsys, ["plan", str(path)]), "robot_radius")
+
+
+def test_console_script_exit_codes(tmp_path, near):
+    exe = Path(sys.executable).parent / "htetro-opt"
+    assert exe.exists(), exe
+    bad = subprocess.run([str(exe), "simulate", near, "--commands", "x+ zz"],
+                         capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2
+    assert bad.stdout == ""
+    assert "Traceback" not in bad.stderr
+    assert bad.stderr.splitlines() == [bad.stderr.strip()] and bad.stderr.startswith("error: unknown command 'zz'")
+    good = subprocess.run([str(exe), "simulate", near, "--commands", "x+ x+", "--json"],
+                          capture_output=True, text=True, timeout=60)
+    assert good.returncode == 0, good.stderr
+    assert json.loads(good.stdout)["reached"] is True
