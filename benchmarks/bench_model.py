@@ -23,7 +23,7 @@ import time
 import networkx as nx
 import numpy as np
 
-from htetro_opt.model import Simulator, command_set
+from htetro_opt.model import Simulator
 from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers import plan_exact
 

@@ -4,6 +4,7 @@ from htetro_opt.errors import (
     ConfigurationError,
     HtetroError,
     MapFormatError,
+    ParameterError,
     PlanningError,
     ScenarioError,
     UnknownCommandError,
@@ -21,4 +22,5 @@ __all__ = [
     "UnknownShapeError",
     "UnknownCommandError",
     "PlanningError",
+    "ParameterError",
 ]

@@ -15,6 +15,7 @@ __all__ = [
     "UnknownShapeError",
     "UnknownCommandError",
     "PlanningError",
+    "ParameterError",
 ]
 
 
@@ -50,3 +51,7 @@ class UnknownCommandError(HtetroError, KeyError):
 
 class PlanningError(HtetroError, RuntimeError):
     """A planner was asked something it cannot do (e.g. an empty roadmap)."""
+
+
+class ParameterError(HtetroError, ValueError):
+    """An option has an invalid value: a negative clearance or duration, an empty command set."""

@@ -18,7 +18,7 @@ from typing import Iterable
 
 import numpy as np
 
-from htetro_opt.errors import UnknownCommandError
+from htetro_opt.errors import ParameterError, UnknownCommandError
 from htetro_opt.model.robot import SHAPES
 
 __all__ = [
@@ -122,8 +122,8 @@ class Timing:
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
-                raise ValueError(f"Timing.{f.name} must be a finite number >= 0, got {value!r}")
+            if isinstance(value, bool) or not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                raise ParameterError(f"Timing.{f.name} must be a finite number >= 0, got {value!r}")
 
     def durations(self) -> np.ndarray:
         """Duration of every command, indexed by command id."""
@@ -191,6 +191,15 @@ def format_commands(ids: Iterable[int]) -> list[str]:
 def command_set(*, diagonals: bool = False, seed004: bool = False, tokens: Iterable[str] | None = None) -> tuple[int, ...]:
     """Ids of a command set: seed 000's by default, plus diagonals, or seed 004's, or explicit tokens.
 
+    Repeated tokens count once.
+
+    Raises
+    ------
+    UnknownCommandError
+        If a token is not in the vocabulary.
+    ParameterError
+        If the set is empty.
+
     Examples
     --------
     >>> len(command_set()), len(command_set(diagonals=True)), len(command_set(seed004=True))
@@ -203,6 +212,6 @@ def command_set(*, diagonals: bool = False, seed004: bool = False, tokens: Itera
     else:
         chosen = list(SEED000_COMMANDS) + (list(DIAGONAL_COMMANDS) if diagonals else [])
     ids = parse_commands(chosen).tolist()
-    if len(set(ids)) != len(ids):
-        raise ValueError(f"command set lists a command twice: {chosen}")
-    return tuple(ids)
+    if not ids:
+        raise ParameterError("a command set needs at least one command")
+    return tuple(dict.fromkeys(ids))

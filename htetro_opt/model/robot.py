@@ -123,6 +123,7 @@ STATE_NAMES: tuple[str, ...] = SHAPES + tuple("h" + "".join(map(str, t)) for t i
 N_NAMED = len(SHAPES)
 N_STATES = len(HINGE_STATES)
 _STATE_INDEX = {name: i for i, name in enumerate(STATE_NAMES)}
+_STATE_BY_HINGES = {triple: i for i, triple in enumerate(HINGE_STATES)}
 
 
 def rotate_cells(cells: np.ndarray, heading: int) -> np.ndarray:
@@ -199,6 +200,52 @@ class Pose(NamedTuple):
             raise ConfigurationError(f"pose heading must be 0, 1, 2 or 3 (quarter turns), got {heading}")
         shape_index(shape)
         return cls(int(x), int(y), str(shape), int(heading))
+
+    @classmethod
+    def from_q(cls, q) -> "Pose":
+        """The pose of a configuration q = (x, y, θB1, θB2, θB3, θB4) (MODEL.md §2).
+
+        The angles are radians, multiples of π/2; θB2 gives the heading and the hinge angles
+        θH1 = π/2 + θB1 − θB2, θH2 = π/2 + θB2 − θB3, θH3 = π/2 + θB4 − θB3 (taken modulo 2π) give the
+        state.
+
+        Raises
+        ------
+        ConfigurationError
+            If an angle is not a multiple of π/2, a hinge leaves [π/2, 3π/2], or two blocks overlap.
+
+        Examples
+        --------
+        >>> Pose.from_q((3, 4, 0, 0, -np.pi, -np.pi))  # seed 004's O-shape
+        Pose(x=3, y=4, shape='O', heading=0)
+        """
+        x, y, *angles = q
+        if len(angles) != 4:
+            raise ConfigurationError(f"q must be (x, y, θB1, θB2, θB3, θB4), got {len(angles) + 2} values")
+        quarters = np.asarray(angles, dtype=float) / (math.pi / 2)
+        if not np.allclose(quarters, np.rint(quarters), atol=1e-9):
+            raise ConfigurationError(f"block angles must be multiples of π/2, got {list(angles)}")
+        b1, b2, b3, b4 = (int(v) for v in np.rint(quarters))
+        hinges = tuple((1 + d) % 4 for d in (b1 - b2, b2 - b3, b4 - b3))
+        if hinges not in _STATE_BY_HINGES:
+            raise ConfigurationError(
+                f"q {tuple(q)} has hinge angles {tuple(h * 90 for h in hinges)}° outside [90°, 270°] "
+                "or overlapping blocks"
+            )
+        return cls.of(int(x), int(y), STATE_NAMES[_STATE_BY_HINGES[hinges]], b2 % N_HEADINGS)
+
+    @property
+    def q(self) -> tuple[int, int, float, float, float, float]:
+        """The configuration (x, y, θB1, θB2, θB3, θB4), angles in radians with θB2 in [0, 2π)."""
+        h1, h2, h3 = HINGE_STATES[shape_index(self.shape)]
+        b2 = self.heading
+        b1, b3 = b2 + h1 - 1, b2 - h2 + 1
+        b4 = b3 + h3 - 1
+        return (self.x, self.y, *(float(b * math.pi / 2) for b in (b1, b2, b3, b4)))
+
+    def cells(self) -> np.ndarray:
+        """Cells (x, y) of B1, B2, B3, B4, shape (4, 2)."""
+        return FOOTPRINTS[shape_index(self.shape), self.heading] + (self.x, self.y)
 
     def as_dict(self) -> dict:
         return {"x": self.x, "y": self.y, "shape": self.shape, "heading": self.heading}

@@ -4,10 +4,10 @@ A :class:`Simulator` compiles, once per workspace, command set, timing and clear
 table ``next[pose, command]``: poses are the flat ids ``((state * 4 + heading) * H + y) * W + x``,
 ``next`` holds the pose after the command or ``dead`` where the command's swept cells are not all
 inside the map and free, and an extra ``pad`` command leaves every pose unchanged. Simulating a batch
-is then one add and one gather per step for the whole batch (the table is kept premultiplied by its
-column count, so the gathered value plus the next command is the next index). Moving obstacles add, per time step, a sorted array
-of blocked ``pose * n_columns + command`` keys (the swept-cell table turned inside out), checked with
-one ``searchsorted`` per step.
+is then one add and one gather per step for the whole batch: the table is kept premultiplied by its
+column count, so a gathered value plus the next command is the next index. Moving obstacles add, per
+time step, a sorted array of blocked ``pose * n_columns + command`` keys (the swept-cell table turned
+inside out), checked with one ``searchsorted`` per step.
 
 Time for moving obstacles is the number of commands executed (MODEL.md §5): command number t (from 0,
 counted from ``t0``) must keep its swept cells clear of every cell a moving obstacle covers between
@@ -30,7 +30,6 @@ from htetro_opt.model.commands import (
     Timing,
     command_id,
     command_set,
-    parse_commands,
 )
 from htetro_opt.model.robot import N_HEADINGS, N_NAMED, N_STATES, STATE_NAMES, Pose, shape_index
 from htetro_opt.model.sweeps import SweepTables, sweep_tables
@@ -110,6 +109,7 @@ class Simulator:
 
     Examples
     --------
+    >>> from htetro_opt.model import parse_commands
     >>> sim = Simulator(Workspace(np.zeros((6, 6), dtype=bool)))
     >>> result = sim.run([parse_commands("x+,x+,y+")], Pose(1, 2, "O", 0))
     >>> result.final_pose(0), float(result.time[0])
@@ -131,9 +131,13 @@ class Simulator:
             ids = command_set(diagonals=diagonals)
         else:
             listed = list(commands)
-            ids = tuple(int(c) for c in (parse_commands(listed) if listed and isinstance(listed[0], str) else listed))
-            if any(not 0 <= c < N_COMMANDS for c in ids) or len(set(ids)) != len(ids):
-                raise ValueError(f"invalid command set {listed!r}")
+            if all(isinstance(c, str) for c in listed):
+                ids = command_set(tokens=listed)
+            else:
+                bad = [c for c in listed if isinstance(c, bool) or not isinstance(c, (int, np.integer)) or not 0 <= c < N_COMMANDS]
+                if bad:
+                    raise UnknownCommandError(f"command set holds {bad[0]!r}: neither a token nor a command id")
+                ids = command_set(tokens=[TOKENS[c] for c in listed])
         self.workspace = workspace
         self.timing = timing if timing is not None else Timing()
         self.tables: SweepTables = sweep_tables(float(clearance))
@@ -156,12 +160,14 @@ class Simulator:
         """valid[state, heading, command, y, x] for a free-cell map (True = free)."""
         t = self.tables
         offsets = t.offsets[: self.n_states, :, self.command_ids]  # (S, 4, C, K, 2)
-        pad = int(np.abs(offsets).max()) + 1
+        margin = int(np.abs(offsets).max()) + 1
         h, w = free.shape
-        padded = np.zeros((h + 2 * pad, w + 2 * pad), dtype=bool)
-        padded[pad : pad + h, pad : pad + w] = free
+        framed = np.zeros((h + 2 * margin, w + 2 * margin), dtype=bool)  # outside the map is blocked
+        framed[margin : margin + h, margin : margin + w] = free
         distinct, inverse = np.unique(offsets.reshape(-1, 2), axis=0, return_inverse=True)
-        shifted = np.stack([padded[pad + oy : pad + oy + h, pad + ox : pad + ox + w] for ox, oy in distinct])
+        shifted = np.stack([
+            framed[margin + oy : margin + oy + h, margin + ox : margin + ox + w] for ox, oy in distinct
+        ])
         which = inverse.reshape(offsets.shape[:-1])
         valid = shifted[which[..., 0]]
         for k in range(1, which.shape[-1]):
@@ -232,15 +238,12 @@ class Simulator:
         ConfigurationError
             If the pose is outside the map or its state is not used by this simulator.
         """
-        pose = Pose.of(*pose)
+        pose, ws = Pose.of(*pose), self.workspace
         s = shape_index(pose.shape)
         if s >= self.n_states:
             raise ConfigurationError(f"state {pose.shape!r} needs seed 004's block commands")
-        if not self.workspace.contains(pose.x, pose.y):
-            raise ConfigurationError(
-                f"pose ({pose.x}, {pose.y}) lies outside the {self.workspace.width} x {self.workspace.height} map"
-            )
-        ws = self.workspace
+        if not ws.contains(pose.x, pose.y):
+            raise ConfigurationError(f"pose ({pose.x}, {pose.y}) lies outside the {ws.width} x {ws.height} map")
         return int(((s * N_HEADINGS + pose.heading) * ws.height + pose.y) * ws.width + pose.x)
 
     def decode(self, ids) -> np.ndarray:
@@ -360,7 +363,7 @@ class Simulator:
         """Keys ``pose * n_columns`` after each step, shape (L + 1, B): the hot loop."""
         batch, width = local.shape
         flat = self._flat_next
-        columns, dead_key = self.n_columns, self.dead * self.n_columns
+        dead_key = self.dead * self.n_columns
         steps = np.ascontiguousarray(local.T, dtype=flat.dtype)  # (L, B): one contiguous row per step
         keys = np.empty((width + 1, batch), dtype=flat.dtype)
         keys[0] = start_key

@@ -23,6 +23,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from htetro_opt.errors import ParameterError
 from htetro_opt.model.commands import COMMANDS, N_COMMANDS, Command
 from htetro_opt.model.robot import HINGE_STATES, N_HEADINGS, N_STATES, block_poses, rotate_cells
 
@@ -173,6 +174,11 @@ def sweep_tables(clearance: float = 0.0) -> SweepTables:
     -------
     SweepTables
 
+    Raises
+    ------
+    ParameterError
+        If the clearance is negative or not a finite number.
+
     Examples
     --------
     >>> tables = sweep_tables()
@@ -180,7 +186,7 @@ def sweep_tables(clearance: float = 0.0) -> SweepTables:
     16
     """
     if isinstance(clearance, bool) or not (isinstance(clearance, (int, float)) and math.isfinite(clearance) and clearance >= 0):
-        raise ValueError(f"clearance must be a finite number >= 0, got {clearance!r}")
+        raise ParameterError(f"clearance must be a finite number >= 0 (cells), got {clearance!r}")
     return _sweep_tables(float(clearance))
 
 

@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from htetro_opt.errors import ConfigurationError, MapFormatError, ScenarioError, UnknownShapeError
-from htetro_opt.model.robot import FOOTPRINTS, Pose, shape_index
+from htetro_opt.model.robot import Pose, shape_index
 from htetro_opt.model.workspace import MovingObstacle, Workspace
 from htetro_opt.scenarios.rosmap import load_ros_map
 
@@ -142,6 +142,19 @@ def _require(table: dict, key: str, kinds, where: str):
     return value
 
 
+def _header(data: dict, allowed: set[str], where: str) -> tuple[str, str, str]:
+    """Check a scenario's keys; its name, source and description."""
+    unknown = set(data) - allowed
+    if unknown:
+        raise ScenarioError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
+    name = _require(data, "name", str, where)
+    source = _require(data, "source", str, where)
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        raise ScenarioError(f"{where}: 'description' must be a string")
+    return name, source, description
+
+
 def _array(data: dict, key: str, where: str, *, tables: bool = False) -> list:
     value = data.get(key, [])
     if not isinstance(value, list):
@@ -215,7 +228,7 @@ def _pose(entry: Any, where: str) -> Pose:
 
 
 def _check_pose_on_map(pose: Pose, occ: np.ndarray, where: str) -> None:
-    cells = FOOTPRINTS[shape_index(pose.shape), pose.heading] + (pose.x, pose.y)
+    cells = pose.cells()
     h, w = occ.shape
     outside = [tuple(c) for c in cells.tolist() if not (0 <= c[0] < w and 0 <= c[1] < h)]
     if outside:
@@ -244,12 +257,7 @@ def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = N
     """
     if "grid" not in data and "map" not in data and ("width" in data or "robots" in data):
         return _parse_continuous(data, where=where, base=base)
-    unknown = set(data) - _GRID_KEYS
-    if unknown:
-        raise ScenarioError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
-    name = _require(data, "name", str, where)
-    source = _require(data, "source", str, where)
-    description = data.get("description", "")
+    name, source, description = _header(data, _GRID_KEYS, where)
     if ("grid" in data) == ("map" in data):
         raise ScenarioError(f"{where}: give exactly one of 'grid' (text rows) or 'map' (a ROS map YAML)")
     cell_size = data.get("cell_size_m")
@@ -263,8 +271,6 @@ def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = N
         if not map_path.is_absolute() and base is not None:
             map_path = base / map_path
         occ, cell_size = load_ros_map(map_path, cell_size=None if cell_size is None else float(cell_size))
-    if not isinstance(description, str):
-        raise ScenarioError(f"{where}: 'description' must be a string")
     moving = []
     for i, entry in enumerate(_array(data, "moving", where, tables=True), start=1):
         at = f"{where}: moving[{i}]"
@@ -302,14 +308,7 @@ def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = N
 
 
 def _parse_continuous(data: dict, *, where: str, base: Path | None) -> ContinuousScenario:
-    unknown = set(data) - _CONTINUOUS_KEYS
-    if unknown:
-        raise ScenarioError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
-    name = _require(data, "name", str, where)
-    source = _require(data, "source", str, where)
-    description = data.get("description", "")
-    if not isinstance(description, str):
-        raise ScenarioError(f"{where}: 'description' must be a string")
+    name, source, description = _header(data, _CONTINUOUS_KEYS, where)
     width = _number(data, "width", where)
     height = _number(data, "height", where)
     radius = _number(data, "robot_radius", where, default=0.0)

@@ -18,7 +18,7 @@ from __future__ import annotations
 import heapq
 import math
 import time as _time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
@@ -52,23 +52,26 @@ class Plan:
     failed_leg: int = -1
     runtime_s: float = 0.0
     method: str = "exact"
-    info: dict = field(default_factory=dict)
 
     @property
     def tokens(self) -> list[str]:
         return [COMMANDS[int(c)].token for c in self.commands]
 
     def objectives(self) -> dict:
-        """Path metrics: time, number of commands by kind, B2's travelled distance."""
-        kinds = [COMMANDS[int(c)].kind for c in self.commands]
-        shifts = np.array([COMMANDS[int(c)].shift for c in self.commands], dtype=float).reshape(-1, 2)
+        """Path metrics: time, number of commands by kind, B2's travelled distance.
+
+        Seed 004's ``2l/2r`` count as rotations, its other block commands as shapeshifts.
+        """
+        commands = [COMMANDS[int(c)] for c in self.commands]
+        moves = [c for c in commands if c.kind in ("translation", "diagonal")]
+        turns = [c for c in commands if c.turn != 0]
         return {
             "time": float(self.time),
-            "n_commands": len(kinds),
-            "translations": sum(k in ("translation", "diagonal") for k in kinds),
-            "rotations": sum(k == "rotation" or (k == "block" and COMMANDS[int(c)].turn != 0) for k, c in zip(kinds, self.commands)),
-            "shapeshifts": sum(k == "shapeshift" or (k == "block" and COMMANDS[int(c)].turn == 0) for k, c in zip(kinds, self.commands)),
-            "path_length": float(np.hypot(shifts[:, 0], shifts[:, 1]).sum()),
+            "n_commands": len(commands),
+            "translations": len(moves),
+            "rotations": len(turns),
+            "shapeshifts": sum(c.kind == "shapeshift" or any(c.hinge_delta) for c in commands),
+            "path_length": float(sum(math.hypot(*c.shift) for c in moves)),
         }
 
 
@@ -136,16 +139,17 @@ class _Graph:
 
     def step_command(self, u: int, v: int, phase: int) -> int:
         """Local command of the cheapest usable edge u → v at time ``phase``."""
-        candidates = np.flatnonzero((self.target[u] == v) & self._usable_row(u, phase))
+        candidates = np.flatnonzero((self.target[u] == v) & self.usable_row(u, phase))
         return int(candidates[np.argmin(self.sim.durations[candidates])])
 
-    def _usable_row(self, u: int, phase: int) -> np.ndarray:
+    def usable_row(self, u: int, phase: int) -> np.ndarray:
+        """Which commands can be executed from pose u at time ``phase``."""
+        if not self.sim.workspace.moving:
+            return self.usable[u]
         row = self.usable[u].copy()
-        if self.sim.workspace.moving:
-            keys = self.sim.blocked_keys(phase)
-            columns = self.sim.n_columns
-            mine = keys[(keys // columns) == u] % columns
-            row[mine] = False
+        keys = self.sim.blocked_keys(phase)
+        columns = self.sim.n_columns
+        row[keys[(keys // columns) == u] % columns] = False
         return row
 
 
@@ -168,15 +172,13 @@ def _dijkstra_leg(graph: _Graph, start: int, goal: int, t0: int) -> list[int] | 
 def _astar_leg(graph: _Graph, start: int, goal: int, t0: int, heuristic: np.ndarray) -> list[int] | None:
     sim = graph.sim
     period, n = sim.workspace.period, sim.n_poses
-    w = sim.workspace.width
-    cell_of = lambda pose: pose % (w * sim.workspace.height)  # noqa: E731 - (y * W + x) of a pose id
+    cells = sim.workspace.width * sim.workspace.height  # pose % cells is the pose's cell y * W + x
     flat_h = heuristic.ravel()
     durations = sim.durations[: sim.n_commands].tolist()
     source = (t0 % period) * n + start
     best = {source: 0.0}
     parent: dict[int, tuple[int, int]] = {}
-    frontier = [(flat_h[cell_of(start)], 0.0, source)]
-    moving = bool(sim.workspace.moving)
+    frontier = [(flat_h[start % cells], 0.0, source)]
     while frontier:
         _, g, node = heapq.heappop(frontier)
         if g > best.get(node, math.inf):
@@ -189,7 +191,7 @@ def _astar_leg(graph: _Graph, start: int, goal: int, t0: int, heuristic: np.ndar
                 commands.append(column)
             return commands[::-1]
         row = graph.target[pose].tolist()
-        usable = (graph._usable_row(pose, phase) if moving else graph.usable[pose]).tolist()
+        usable = graph.usable_row(pose, phase).tolist()
         next_phase = (phase + 1) % period
         for column, target in enumerate(row):
             if not usable[column]:
@@ -199,7 +201,7 @@ def _astar_leg(graph: _Graph, start: int, goal: int, t0: int, heuristic: np.ndar
             if cost < best.get(child, math.inf):
                 best[child] = cost
                 parent[child] = (node, column)
-                heapq.heappush(frontier, (cost + flat_h[cell_of(target)], cost, child))
+                heapq.heappush(frontier, (cost + flat_h[target % cells], cost, child))
     return None
 
 
@@ -276,7 +278,7 @@ def plan_exact(
         else:
             goal_cell = tuple(int(v) for v in sim.decode(b)[:2])
             h = grid_distance(sim.workspace, goal_cell, diagonals=has_diagonals) * per_cell
-            steps = _astar_leg(graph, a, b, len(local), np.where(np.isfinite(h), h, np.inf))
+            steps = _astar_leg(graph, a, b, len(local), h)
         if steps is None:
             failed = leg
             break

@@ -106,7 +106,7 @@ def plot_path(
         ax.plot(poses[:, 0], poses[:, 1], color="black", linewidth=1.2, marker=".", markersize=3, label="B2 path")
     for i, pose in enumerate(roadmap):
         edge = "green" if i == 0 else "red" if i == len(roadmap) - 1 else "blue"
-        for bx, by in FOOTPRINTS[shape_index(pose.shape), pose.heading] + (pose.x, pose.y):
+        for bx, by in pose.cells():
             ax.add_patch(Rectangle((bx - 0.5, by - 0.5), 1, 1, facecolor="none", edgecolor=edge, linewidth=2.2, linestyle="--"))
     handles = [Patch(facecolor=_colour(shape_index(n)), alpha=0.6, label=f"{n}-shape" if n in SHAPES else n) for n in used]
     if roadmap:

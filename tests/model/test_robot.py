@@ -92,3 +92,35 @@ def test_unknown_shape_and_bad_poses_raise_typed_errors():
         Pose.of(0, 0, "O", 4)
     with pytest.raises(ConfigurationError, match="x"):
         Pose.of(0.5, 0, "O", 0)
+
+
+@pytest.mark.parametrize("q,expected", [
+    ((0, 0, 0, 0, 0, 0), ("I", 0)),  # seed 004's vertical I
+    ((0, 0, 0, 0, -math.pi, -math.pi), ("O", 0)),  # seed 004's O
+    ((0, 0, -math.pi / 2, -math.pi / 2, -math.pi / 2, -math.pi / 2), ("I", 3)),  # horizontal I
+])
+def test_pose_from_seed_004_configurations(q, expected):
+    pose = Pose.from_q(q)
+    assert (pose.shape, pose.heading) == expected
+
+
+@pytest.mark.parametrize("state", range(N_STATES))
+@pytest.mark.parametrize("heading", range(4))
+def test_q_round_trips_and_gives_the_footprint(state, heading):
+    pose = Pose(2, 3, STATE_NAMES[state], heading)
+    assert Pose.from_q(pose.q) == pose
+    x, y, *angles = pose.q
+    hinges = (math.pi / 2 + angles[0] - angles[1], math.pi / 2 + angles[1] - angles[2], math.pi / 2 + angles[3] - angles[2])
+    centres, _ = block_poses(np.array(hinges), angles[1])
+    assert np.rint(centres).astype(int).tolist() == (pose.cells() - (x, y)).tolist()
+
+
+@pytest.mark.parametrize("q,words", [
+    ((0, 0, 0.1, 0, 0, 0), "multiples of π/2"),
+    ((0, 0, -math.pi / 2, 0, 0, 0), "outside"),  # θH1 = 0: B1 would fold past B2
+    ((0, 0, math.pi, 0, -math.pi, -math.pi), "overlapping"),  # hinges (3π/2, 3π/2, π/2): B1 on B3
+    ((0, 0, 0, 0, 0), "θB4"),
+])
+def test_bad_configurations_are_rejected(q, words):
+    with pytest.raises(ConfigurationError, match=words):
+        Pose.from_q(q)

@@ -3,6 +3,8 @@
 import numpy as np
 import pytest
 
+from htetro_opt.errors import ParameterError
+
 from htetro_opt.model.commands import COMMANDS, command_id
 from htetro_opt.model.robot import FOOTPRINTS, N_STATES, SHAPES, rotate_cells, shape_index
 from htetro_opt.model.sweeps import motion_samples, swept_cells, sweep_tables
@@ -43,7 +45,7 @@ def test_shapeshift_sweep_sizes(tables, source):
 def test_every_sweep_contains_start_and_end_footprints(tables):
     for s in range(N_STATES):
         for h in range(4):
-            for c, cmd in enumerate(COMMANDS):
+            for c in range(len(COMMANDS)):
                 if not tables.legal[s, c]:
                     continue
                 cells = as_set(tables.cells(s, h, c))
@@ -121,5 +123,5 @@ def test_seed_004_block_commands(tables):
 
 
 def test_bad_clearance_is_rejected():
-    with pytest.raises(ValueError, match="clearance"):
+    with pytest.raises(ParameterError, match="clearance"):
         sweep_tables(-0.1)
