@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import os
+import stat
 import subprocess
 import sys
 from pathlib import Path
@@ -356,3 +358,14 @@ def test_console_script_exit_codes(tmp_path, near):
                           capture_output=True, text=True, timeout=60)
     assert good.returncode == 0, good.stderr
     assert json.loads(good.stdout)["reached"] is True
+
+
+def test_plot_file_gets_a_normal_file_mode(capsys, tmp_path, near):
+    out = tmp_path / "mode.png"
+    old = os.umask(0o022)
+    try:
+        assert main(["plan", near, "--plot", str(out)]) == 0
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(out.stat().st_mode) == 0o644
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".htetro-")]

@@ -10,7 +10,10 @@ ended (seed 000's configuration loop); each leg is time-optimal.
 
 Two algorithms give the same optimum: ``"dijkstra"`` (scipy.sparse.csgraph over the whole graph, the
 fastest here) and ``"astar"`` (a heapq A* that expands only what it needs, with the admissible
-heuristic "grid distance of B2's cell to the goal × the cheapest translation time per cell").
+heuristic "grid distance of B2's cell to the goal × the cheapest translation time per cell"). When
+moving obstacles have a long common period the whole time-expanded graph would not fit in memory
+(more than :data:`MAX_EXPANDED_NODES` nodes): "dijkstra" then hands over to A*, and the plan's
+``method`` says so. A leg that is unreachable even without the moving obstacles is reported at once.
 """
 
 from __future__ import annotations
@@ -34,6 +37,8 @@ from htetro_opt.model.workspace import Workspace, grid_distance
 __all__ = ["Plan", "plan_exact", "ALGORITHMS"]
 
 ALGORITHMS = ("dijkstra", "astar")
+MAX_EXPANDED_NODES = 8_000_000
+"""Above this many time-expanded nodes (poses × obstacle period), "dijkstra" hands over to the lazy A*."""
 
 
 @dataclass(frozen=True)
@@ -76,14 +81,19 @@ class Plan:
 
 
 class _Graph:
-    """The simulator's transition table as a (time-expanded) CSR graph, cheapest command per edge."""
+    """The simulator's transition table as a (time-expanded) CSR graph, cheapest command per edge.
 
-    def __init__(self, sim: Simulator) -> None:
+    With ``static``, moving obstacles are ignored (the table itself only knows the static map).
+    """
+
+    def __init__(self, sim: Simulator, *, static: bool = False) -> None:
         self.sim = sim
+        self.moving = bool(sim.workspace.moving) and not static
+        self.period = sim.workspace.period if self.moving else 1
         n, c = sim.n_poses, sim.n_commands
         self.target = sim.next[:n, :c]
         usable = self.target != sim.dead
-        if not sim.workspace.moving:
+        if not self.moving:
             # A command that leaves the pose unchanged is useless on a static map; with moving
             # obstacles it is a wait, which advances their clock.
             usable &= self.target != np.arange(n, dtype=self.target.dtype)[:, None]
@@ -111,7 +121,7 @@ class _Graph:
         return pairs
 
     def _usable_at(self, phase: int) -> np.ndarray:
-        if not self.sim.workspace.moving:
+        if not self.moving:
             return self.usable
         keys = self.sim.blocked_keys(phase)
         usable = self.usable.copy()
@@ -123,7 +133,7 @@ class _Graph:
         """The whole graph: node = phase * n_poses + pose, one edge per usable (pose, command)."""
         if self._matrix is None:
             sim = self.sim
-            period, n = sim.workspace.period, sim.n_poses
+            period, n = self.period, sim.n_poses
             weights = np.broadcast_to(sim.durations[: sim.n_commands], self.target.shape)
             indptr, indices, data = [np.zeros(1, dtype=np.int64)], [], []
             for phase in range(period):
@@ -144,7 +154,7 @@ class _Graph:
 
     def usable_row(self, u: int, phase: int) -> np.ndarray:
         """Which commands can be executed from pose u at time ``phase``."""
-        if not self.sim.workspace.moving:
+        if not self.moving:
             return self.usable[u]
         row = self.usable[u].copy()
         keys = self.sim.blocked_keys(phase)
@@ -155,7 +165,7 @@ class _Graph:
 
 def _dijkstra_leg(graph: _Graph, start: int, goal: int, t0: int) -> list[int] | None:
     sim = graph.sim
-    period, n = sim.workspace.period, sim.n_poses
+    period, n = graph.period, sim.n_poses
     source = (t0 % period) * n + start
     dist, pred = dijkstra(graph.matrix(), indices=source, return_predecessors=True)
     goal_nodes = goal + n * np.arange(period)
@@ -171,7 +181,7 @@ def _dijkstra_leg(graph: _Graph, start: int, goal: int, t0: int) -> list[int] | 
 
 def _astar_leg(graph: _Graph, start: int, goal: int, t0: int, heuristic: np.ndarray) -> list[int] | None:
     sim = graph.sim
-    period, n = sim.workspace.period, sim.n_poses
+    period, n = graph.period, sim.n_poses
     cells = sim.workspace.width * sim.workspace.height  # pose % cells is the pose's cell y * W + x
     flat_h = heuristic.ravel()
     durations = sim.durations[: sim.n_commands].tolist()
@@ -261,6 +271,10 @@ def plan_exact(
         workspace, commands=commands, diagonals=diagonals, timing=timing, clearance=clearance
     )
     graph = _Graph(sim)
+    moving = bool(sim.workspace.moving)
+    if algorithm == "dijkstra" and moving and sim.n_poses * sim.workspace.period > MAX_EXPANDED_NODES:
+        algorithm = "astar"
+    static = _Graph(sim, static=True) if moving else graph
     ids = [sim.check_pose(roadmap[0], what="start", t=0)]
     for i, pose in enumerate(roadmap[1:], start=1):
         what = "goal" if i == len(roadmap) - 1 else f"roadmap configuration {i + 1}"
@@ -273,7 +287,9 @@ def plan_exact(
     leg_ends: list[int] = []
     failed = -1
     for leg, (a, b) in enumerate(zip(ids[:-1], ids[1:])):
-        if algorithm == "dijkstra":
+        if moving and _dijkstra_leg(static, a, b, 0) is None:  # moving obstacles only remove edges
+            steps = None
+        elif algorithm == "dijkstra":
             steps = _dijkstra_leg(graph, a, b, len(local))
         else:
             goal_cell = tuple(int(v) for v in sim.decode(b)[:2])

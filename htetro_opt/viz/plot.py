@@ -140,8 +140,11 @@ def save_figure(fig, path: str | Path, *, dpi: int = 120) -> Path:
         raise HtetroError(f"cannot write plot {str(path)!r}: directory {str(directory)!r} does not exist")
     handle, tmp = tempfile.mkstemp(suffix=".png", prefix=".htetro-", dir=directory)
     os.close(handle)
+    umask = os.umask(0)
+    os.umask(umask)
     try:
         fig.savefig(tmp, dpi=dpi, format="png")
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes the file private; give it a normal file's mode
         os.replace(tmp, path)
     except OSError as err:
         raise HtetroError(f"cannot write plot {str(path)!r}: {err.strerror or err}") from err

@@ -168,3 +168,29 @@ def test_clearance_makes_plans_no_shorter():
         assert padded.time >= plain.time
         sim = Simulator(ws, clearance=0.2)
         assert sim.run([padded.commands], start).valid[0]
+
+
+def test_long_obstacle_periods_hand_over_to_astar(monkeypatch):
+    from htetro_opt.solvers import exact
+
+    occ = np.zeros((10, 10), dtype=bool)
+    moving = (
+        MovingObstacle(np.array([[0, 9]]), np.array([[8, 0]])),  # period 16
+        MovingObstacle(np.array([[9, 0]]), np.array([[0, 6]]), mode="loop"),  # period 12
+    )
+    ws = Workspace(occ, moving=moving)
+    roadmap = [Pose(2, 2, "O", 0), Pose(6, 5, "O", 0)]
+    full = plan_exact(ws, roadmap)
+    monkeypatch.setattr(exact, "MAX_EXPANDED_NODES", 10)
+    handed = plan_exact(ws, roadmap)
+    assert full.method == "exact-dijkstra" and handed.method == "exact-astar"
+    assert handed.time == pytest.approx(full.time)
+
+
+def test_statically_unreachable_leg_is_reported_without_a_time_expanded_search():
+    occ = np.zeros((10, 10), dtype=bool)
+    occ[5, :] = True
+    moving = (MovingObstacle(np.array([[0, 8]]), np.array([[8, 0]])),)
+    for algorithm in ("dijkstra", "astar"):
+        plan = plan_exact(Workspace(occ, moving=moving), [Pose(2, 2, "O", 0), Pose(2, 8, "O", 0)], algorithm=algorithm)
+        assert not plan.reached and plan.failed_leg == 0
