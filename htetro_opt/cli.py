@@ -13,7 +13,7 @@ import time
 from typing import Sequence
 
 from htetro_opt import __version__
-from htetro_opt.errors import HtetroError, PlanningError, ScenarioError
+from htetro_opt.errors import HtetroError, ParameterError, PlanningError, ScenarioError
 from htetro_opt.model import Simulator, parse_commands
 from htetro_opt.model.commands import DIAGONAL_COMMANDS, SEED000_COMMANDS
 from htetro_opt.model.robot import STATE_NAMES
@@ -82,8 +82,8 @@ def _pose_dict(row) -> dict:
 
 
 def _check_clearance(value: float) -> float:
-    if not (value >= 0 and value < 10):
-        raise HtetroError(f"--clearance must be between 0 and 10 cells, got {value}")
+    if not 0 <= value < 10:
+        raise ParameterError(f"--clearance must be between 0 and 10 cells, got {value:g}")
     return value
 
 
@@ -130,9 +130,12 @@ def _cmd_plan(args) -> dict:
         save_figure(plot_path(scenario.workspace, plan.poses, roadmap=scenario.roadmap,
                               hidden=scenario.hidden, title=title), args.plot)
     if not args.json:
-        print(f"{scenario.name}: {'reached' if plan.reached else 'NOT reached'} with {args.method} in "
-              f"{runtime:.3f} s; time {plan.time:g}, {len(plan.tokens)} commands")
-        print(" ".join(plan.tokens))
+        legs = len(scenario.roadmap) - 1
+        status = "reached" if plan.reached else f"NOT reached: leg {plan.failed_leg + 1} of {legs} has no path"
+        print(f"{scenario.name}: {status} ({args.method}, {runtime:.3f} s); time {plan.time:g}, "
+              f"{len(plan.tokens)} commands")
+        if plan.tokens:
+            print(" ".join(plan.tokens))
     return out
 
 

@@ -75,6 +75,7 @@ class SimulationResult:
     final: np.ndarray
     simulator: "Simulator"
     keys: np.ndarray  # (L + 1, B) of pose * n_columns, as the simulation loop leaves them
+    local: np.ndarray  # (B, L) of the simulator's command columns, padded with its `pad`
 
     def __len__(self) -> int:
         return len(self.valid)
@@ -82,6 +83,10 @@ class SimulationResult:
     @cached_property
     def trace(self) -> np.ndarray:
         return (self.keys // self.simulator.n_columns).T.astype(np.int64)
+
+    def prefix(self, i: int) -> np.ndarray:
+        """The executed prefix of sequence i, as global command ids."""
+        return self.simulator.command_ids[self.local[i, : self.executed[i]]]
 
     def poses(self, i: int) -> np.ndarray:
         """Poses visited by sequence i, start included: shape (executed + 1, 4) of (x, y, state, heading)."""
@@ -421,6 +426,7 @@ class Simulator:
             final=self.decode(final_ids),
             simulator=self,
             keys=keys,
+            local=local,
         )
 
 

@@ -67,6 +67,7 @@ def test_batch_matches_reference_on_random_sequences(clearance):
         assert tuple(result.final[i]) == final
         assert result.time[i] == pytest.approx(total)
         assert result.executed[i] == (first if first >= 0 else len(seq))
+        assert result.prefix(i).tolist() == parse_commands(seq[: result.executed[i]]).tolist()
     assert 0 < result.valid.sum() < len(tokens)  # the sample exercises both outcomes
 
 
