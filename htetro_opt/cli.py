@@ -32,7 +32,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 class _UsageError(Exception):
-    pass
+    """A command-line usage error, reported like every other error: one line, exit status 2."""
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -369,3 +369,12 @@ def test_plot_file_gets_a_normal_file_mode(capsys, tmp_path, near):
         os.umask(old)
     assert stat.S_IMODE(out.stat().st_mode) == 0o644
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".htetro-")]
+
+
+def test_simulate_runs_in_the_true_world_and_plan_in_the_known_map(capsys, tmp_path):
+    # A hidden obstacle right of the start: unknown to the planner, there when the plan is executed.
+    path = scenario(tmp_path / "hidden.toml", roadmap=pose(2, 2, "O") + pose(6, 2, "O"), extra="hidden = [[4, 2]]")
+    plan = run_json(capsys, ["plan", path, "--json"])
+    assert plan["reached"] is True and plan["commands"] == ["x+"] * 4
+    out = run_json(capsys, ["simulate", path, "--commands", ",".join(plan["commands"]), "--json"])
+    assert out["valid"] is False and out["executed"] == 0 and out["reached"] is False  # x+ reaches x = 4
