@@ -34,7 +34,7 @@ _MAX_TURN_PER_SAMPLE = math.radians(2.0)
 _SAMPLES_PER_CELL = 16
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
 class SweepTables:
     """Per-(state, heading, command) transition and swept-cell tables of the robot.
 

@@ -19,7 +19,7 @@ from htetro_opt.errors import ConfigurationError, ScenarioError
 __all__ = ["Workspace", "MovingObstacle", "grid_distance"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
 class MovingObstacle:
     """A rigid group of cells patrolling a route.
 
@@ -89,7 +89,7 @@ class MovingObstacle:
         return (self.cells[None, :, :] + shifts[:, None, :]).reshape(-1, 2)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
 class Workspace:
     """A W × H grid of cells with static occupancy and optional moving obstacles.
 

@@ -50,7 +50,7 @@ _GRID_KEYS = {"name", "source", "description", "cell_size_m", "grid", "map", "ro
 _CONTINUOUS_KEYS = {"name", "source", "description", "width", "height", "obstacles", "robot_radius", "robots"}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
 class Scenario:
     """A grid environment with its roadmap (first configuration = start, last = goal)."""
 
@@ -77,7 +77,7 @@ class Scenario:
         return Workspace(occ, self.workspace.cell_size, self.workspace.moving)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
 class ContinuousScenario:
     """A continuous W × H rectangle with polygon obstacles and point robots (seed 002)."""
 

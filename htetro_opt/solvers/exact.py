@@ -41,7 +41,7 @@ MAX_EXPANDED_NODES = 8_000_000
 """Above this many time-expanded nodes (poses × obstacle period), "dijkstra" hands over to the lazy A*."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
 class Plan:
     """A plan: global command ids from the roadmap's start, and what it achieves.
 

@@ -220,3 +220,9 @@ def test_translations_keep_shape_and_heading_and_add_up(tokens):
     shift = np.sum([COMMANDS[command_id(t)].shift for t in tokens] or [[0, 0]], axis=0)
     assert r.valid[0]
     assert tuple(r.final[0]) == (35 + shift[0], 35 + shift[1], shape_index("T"), 2)
+
+
+def test_array_holding_objects_compare_by_identity_and_hash():
+    a, b = Workspace(np.zeros((3, 3), dtype=bool)), Workspace(np.zeros((3, 3), dtype=bool))
+    assert a == a and a != b
+    assert len({a, b, MovingObstacle(np.array([[0, 0]]), np.array([[1, 0]]))}) == 3
