@@ -266,13 +266,8 @@ class Simulator:
         With ``t``, moving obstacles at time t count too.
         """
         x, y, s, h = (int(v) for v in self.decode(pose_id))
-        ws = self.workspace
-        occ = ws.occupancy if t is None else ws.occupancy_at(t)
-        cells = self.tables.cells(s, h, _STOP) + (x, y)
-        return [
-            (cx, cy) for cx, cy in cells.tolist()
-            if not ws.contains(cx, cy) or occ[cy, cx]
-        ]
+        outside, occupied = self.workspace.conflicts(self.tables.cells(s, h, _STOP) + (x, y), t)
+        return outside + occupied
 
     def check_pose(self, pose: Pose, *, what: str = "pose", t: int | None = None) -> int:
         """Encode a pose and check it is collision-free; its flat id.

@@ -146,6 +146,24 @@ class Workspace:
         occ = self.occupancy if t is None else self.occupancy_at(t)
         return not occ[y, x]
 
+    def conflicts(self, cells, t: int | None = None) -> tuple[list[tuple[int, int]], list[tuple[int, int]]]:
+        """Which of some (x, y) cells lie outside the map, and which on an obstacle.
+
+        With ``t``, moving obstacles at time t count too.
+
+        Returns
+        -------
+        outside, occupied : list of (int, int)
+        """
+        occ = self.occupancy if t is None else self.occupancy_at(t)
+        outside, occupied = [], []
+        for x, y in np.asarray(cells).reshape(-1, 2).tolist():
+            if not self.contains(x, y):
+                outside.append((x, y))
+            elif occ[y, x]:
+                occupied.append((x, y))
+        return outside, occupied
+
     def _mark(self, cells_of) -> np.ndarray:
         occ = np.zeros_like(self.occupancy)
         for obstacle in self.moving:

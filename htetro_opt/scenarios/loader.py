@@ -227,16 +227,13 @@ def _pose(entry: Any, where: str) -> Pose:
         raise ConfigurationError(f"{where}: {err}") from err
 
 
-def _check_pose_on_map(pose: Pose, occ: np.ndarray, where: str) -> None:
-    cells = pose.cells()
-    h, w = occ.shape
-    outside = [tuple(c) for c in cells.tolist() if not (0 <= c[0] < w and 0 <= c[1] < h)]
+def _check_pose_on_map(pose: Pose, workspace: Workspace, where: str, t: int | None = None) -> None:
+    outside, hits = workspace.conflicts(pose.cells(), t)
     if outside:
         raise ConfigurationError(
             f"{where}: {pose.shape}-shape at ({pose.x}, {pose.y}) heading {pose.heading} "
-            f"has block(s) outside the {w} x {h} map at {outside}"
+            f"has block(s) outside the {workspace.width} x {workspace.height} map at {outside}"
         )
-    hits = [tuple(c) for c in cells.tolist() if occ[c[1], c[0]]]
     if hits:
         raise ConfigurationError(
             f"{where}: {pose.shape}-shape at ({pose.x}, {pose.y}) heading {pose.heading} collides with obstacle cell(s) {hits}"
@@ -298,11 +295,11 @@ def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = N
     for i, entry in enumerate(entries, start=1):
         at = f"{where}: roadmap[{i}]" + (" (start)" if i == 1 else " (goal)" if i == len(entries) else "")
         pose = _pose(entry, at)
-        _check_pose_on_map(pose, workspace.occupancy_at(0) if i == 1 else occ, at)
+        _check_pose_on_map(pose, workspace, at, t=0 if i == 1 else None)
         if i == 1 and len(hidden):
             revealed = occ.copy()
             revealed[hidden[:, 1], hidden[:, 0]] = True
-            _check_pose_on_map(pose, revealed, f"{at} (against the hidden obstacles)")
+            _check_pose_on_map(pose, Workspace(revealed), f"{at} (against the hidden obstacles)")
         roadmap.append(pose)
     return Scenario(name, source, workspace, tuple(roadmap), description, hidden, base)
 
