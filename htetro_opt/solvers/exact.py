@@ -224,6 +224,7 @@ def plan_exact(
     timing: Timing | None = None,
     clearance: float = 0.0,
     algorithm: str = "dijkstra",
+    t0: int = 0,
 ) -> Plan:
     """Minimum-time plan through a roadmap of configurations.
 
@@ -241,6 +242,9 @@ def plan_exact(
     clearance : float, keyword-only
         δ in cells (MODEL.md §4).
     algorithm : {"dijkstra", "astar"}, keyword-only
+    t0 : int, keyword-only
+        Commands already executed at the start (the clock of moving obstacles), e.g. to plan one leg
+        of a longer roadmap.
 
     Returns
     -------
@@ -263,6 +267,8 @@ def plan_exact(
     """
     if algorithm not in ALGORITHMS:
         raise PlanningError(f"unknown algorithm {algorithm!r}: expected one of {', '.join(ALGORITHMS)}")
+    if isinstance(t0, bool) or not isinstance(t0, (int, np.integer)) or t0 < 0:
+        raise PlanningError(f"t0 must be a non-negative integer, got {t0!r}")
     roadmap = [Pose.of(*p) for p in roadmap]
     if len(roadmap) < 2:
         raise PlanningError("a roadmap needs a start and a goal (at least two configurations)")
@@ -275,7 +281,7 @@ def plan_exact(
     if algorithm == "dijkstra" and moving and sim.n_poses * sim.workspace.period > MAX_EXPANDED_NODES:
         algorithm = "astar"
     static = _Graph(sim, static=True) if moving else graph
-    ids = [sim.check_pose(roadmap[0], what="start", t=0)]
+    ids = [sim.check_pose(roadmap[0], what="start", t=t0)]
     for i, pose in enumerate(roadmap[1:], start=1):
         what = "goal" if i == len(roadmap) - 1 else f"roadmap configuration {i + 1}"
         ids.append(sim.check_pose(pose, what=what))
@@ -290,18 +296,18 @@ def plan_exact(
         if moving and _dijkstra_leg(static, a, b, 0) is None:  # moving obstacles only remove edges
             steps = None
         elif algorithm == "dijkstra":
-            steps = _dijkstra_leg(graph, a, b, len(local))
+            steps = _dijkstra_leg(graph, a, b, t0 + len(local))
         else:
             goal_cell = tuple(int(v) for v in sim.decode(b)[:2])
             h = grid_distance(sim.workspace, goal_cell, diagonals=has_diagonals) * per_cell
-            steps = _astar_leg(graph, a, b, len(local), h)
+            steps = _astar_leg(graph, a, b, t0 + len(local), h)
         if steps is None:
             failed = leg
             break
         local.extend(steps)
         leg_ends.append(len(local))
     global_ids = sim.command_ids[np.array(local, dtype=np.int64)] if local else np.empty(0, dtype=np.int64)
-    result = sim.run([global_ids], ids[0])
+    result = sim.run([global_ids], ids[0], t0=t0)
     if not result.valid[0]:  # the graph is the simulator's table: this cannot happen unless tables disagree
         raise PlanningError("internal error: the exact plan does not re-validate in the simulator")
     return Plan(

@@ -1,0 +1,36 @@
+"""pymoo operators over variable-length motion-command chromosomes (seed 000).
+
+One operator per module, each a pure function over ``numpy`` arrays beside a thin pymoo class that
+takes the ``random_state`` pymoo passes:
+
+- :mod:`.sampling`: Algorithm 1 (:class:`CommandSampling`);
+- :mod:`.mutation`: per-command mutation (:class:`CommandMutation`);
+- :mod:`.crossover`: single-point crossover of variable-length parents (:class:`CommandCrossover`);
+- :mod:`.removal` and :mod:`.rearrangement`: the conservative operators, which never change B2's
+  total displacement (:class:`CommandRemoval`, :class:`CommandRearrangement`);
+- :mod:`.duplicates`: :class:`CommandDuplicateElimination`;
+- :mod:`.selection`: the size-4 deterministic tournament on rank and crowding;
+- :mod:`.survival`: the goal-reachability sort (:class:`GoalReachabilitySurvival`).
+"""
+
+from htetro_opt.operators._chromosome import as_column, displacement, sequences
+from htetro_opt.operators.crossover import CommandCrossover, single_point_crossover
+from htetro_opt.operators.duplicates import CommandDuplicateElimination, chromosome_key
+from htetro_opt.operators.mutation import CommandMutation, mutate_commands
+from htetro_opt.operators.rearrangement import CommandRearrangement, rearrange_commands
+from htetro_opt.operators.removal import CommandRemoval, remove_commands
+from htetro_opt.operators.sampling import DEFAULT_WEIGHTS, CommandSampling, sample_commands
+from htetro_opt.operators.selection import RankAndCrowdingTournament, rank_and_crowding_tournament
+from htetro_opt.operators.survival import GoalReachabilitySurvival, reaches_goal
+
+__all__ = [
+    "as_column", "displacement", "sequences",
+    "CommandCrossover", "single_point_crossover",
+    "CommandDuplicateElimination", "chromosome_key",
+    "CommandMutation", "mutate_commands",
+    "CommandRearrangement", "rearrange_commands",
+    "CommandRemoval", "remove_commands",
+    "DEFAULT_WEIGHTS", "CommandSampling", "sample_commands",
+    "RankAndCrowdingTournament", "rank_and_crowding_tournament",
+    "GoalReachabilitySurvival", "reaches_goal",
+]

@@ -1,0 +1,50 @@
+"""Single-point crossover of two variable-length command chromosomes (non-conservative)."""
+
+from __future__ import annotations
+
+import numpy as np
+from pymoo.core.crossover import Crossover
+
+from htetro_opt.operators._chromosome import sequences
+
+__all__ = ["CommandCrossover", "single_point_crossover"]
+
+
+def single_point_crossover(rng: np.random.Generator, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Cut each parent at its own random point and swap the tails: ``a[:i] + b[j:]``, ``b[:j] + a[i:]``.
+
+    The cut points are drawn independently (0 … len), so the offspring's lengths vary while their
+    total equals the parents'.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> c, d = single_point_crossover(rng, np.array([1, 1, 1]), np.array([2, 2]))
+    >>> sorted(c.tolist() + d.tolist())
+    [1, 1, 1, 2, 2]
+    """
+    i = int(rng.integers(0, len(a) + 1))
+    j = round(i * len(b) / len(a)) if len(a) else int(rng.integers(0, len(b) + 1))
+    return np.concatenate([a[:i], b[j:]]), np.concatenate([b[:j], a[i:]])
+
+
+class CommandCrossover(Crossover):
+    """The paper's single-point crossover as a pymoo operator: two parents, two offspring.
+
+    Parameters
+    ----------
+    prob : float
+        Probability that a mating crosses over (pymoo's parameter; the hTetro-GA applies its own
+        r_cr when choosing whom to mate, and passes 1.0).
+    """
+
+    def __init__(self, prob: float = 1.0) -> None:
+        super().__init__(n_parents=2, n_offsprings=2, prob=prob)
+
+    def _do(self, problem, X, *args, random_state=None, **kwargs):
+        _, n_matings, _ = X.shape
+        Y = np.empty((2, n_matings, 1), dtype=object)
+        parents_a, parents_b = sequences(X[0]), sequences(X[1])
+        for k in range(n_matings):
+            Y[0, k, 0], Y[1, k, 0] = single_point_crossover(random_state, parents_a[k], parents_b[k])
+        return Y
