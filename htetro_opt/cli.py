@@ -12,18 +12,21 @@ import sys
 import time
 from typing import Sequence
 
+import numpy as np
+
 from htetro_opt import __version__
 from htetro_opt.errors import HtetroError, ParameterError, PlanningError, ScenarioError
 from htetro_opt.model import Simulator, parse_commands
 from htetro_opt.model.commands import DIAGONAL_COMMANDS, SEED000_COMMANDS
 from htetro_opt.model.robot import STATE_NAMES
+from htetro_opt.problems import FITNESS_NAMES
 from htetro_opt.scenarios import Scenario, list_scenarios, load_scenario
-from htetro_opt.solvers import plan_exact
+from htetro_opt.solvers import GA_ALGORITHMS, plan_exact, plan_ga
 
 __all__ = ["main", "main_entry", "build_parser"]
 
 EXIT_ERROR = 2
-PLAN_METHODS = {"exact": "dijkstra", "astar": "astar"}
+PLAN_METHODS = {"exact": "dijkstra", "astar": "astar", "nsga2": "ga"}
 
 
 class _Parser(argparse.ArgumentParser):
@@ -46,7 +49,18 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("plan", help="plan a path through a scenario's roadmap")
     p.add_argument("scenario", help="bundled scenario name or path to a scenario TOML file")
     p.add_argument("--method", choices=sorted(PLAN_METHODS), default="exact",
-                   help="exact: minimum-time Dijkstra (default); astar: A*, same optimum")
+                   help="exact: minimum-time Dijkstra (default); astar: A*, same optimum; "
+                        "nsga2: seed 000's multi-objective GA over command chromosomes")
+    p.add_argument("--algorithm", choices=GA_ALGORITHMS, default="htetro",
+                   help="with --method nsga2: the paper's hTetro-GA (default) or one of pymoo's algorithms")
+    p.add_argument("--pop-size", type=int, default=50, help="with --method nsga2: population size n_pop (default 50)")
+    p.add_argument("--max-gen", type=int, default=1000,
+                   help="with --method nsga2: generations per roadmap leg at most (default 1000)")
+    p.add_argument("--patience", type=int, default=100,
+                   help="with --method nsga2: stop a leg after this many generations without improvement "
+                        "once its goal is reached (default 100)")
+    p.add_argument("--max-length", type=int, default=100,
+                   help="with --method nsga2: l_p,max, the initial chromosome length (default 100)")
     p.add_argument("--seed", type=int, default=0, help="random seed (the exact methods are deterministic)")
     p.add_argument("--diagonals", action="store_true", help="allow diagonal translations")
     p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block")
@@ -110,8 +124,20 @@ def _cmd_plan(args) -> dict:
     if scenario.goal is None:
         raise PlanningError(f"scenario {scenario.name!r} has no roadmap with a start and a goal to plan for")
     began = time.perf_counter()
-    plan = plan_exact(scenario.workspace, scenario.roadmap, diagonals=args.diagonals,
-                      clearance=clearance, algorithm=PLAN_METHODS[args.method])
+    genetic = args.method == "nsga2"
+    if genetic:
+        if args.diagonals:
+            raise ParameterError("--diagonals is not available with --method nsga2 (seed 000 has no diagonal commands)")
+        for flag, value, least in (("--pop-size", args.pop_size, 2), ("--max-gen", args.max_gen, 1),
+                                   ("--patience", args.patience, 1), ("--max-length", args.max_length, 1)):
+            if value < least:
+                raise ParameterError(f"{flag} must be at least {least}, got {value}")
+        plan = plan_ga(scenario.workspace, scenario.roadmap, algorithm=args.algorithm, pop_size=args.pop_size,
+                       max_gen=args.max_gen, patience=args.patience, max_length=args.max_length,
+                       seed=args.seed, clearance=clearance)
+    else:
+        plan = plan_exact(scenario.workspace, scenario.roadmap, diagonals=args.diagonals,
+                          clearance=clearance, algorithm=PLAN_METHODS[args.method])
     runtime = time.perf_counter() - began
     out = {
         "scenario": scenario.name,
@@ -122,21 +148,61 @@ def _cmd_plan(args) -> dict:
         "objectives": plan.objectives(),
         "runtime_s": round(runtime, 6),
     }
+    if genetic:
+        out.update(_ga_fields(plan, args))
     if args.plot:
-        from htetro_opt.viz import plot_path, save_figure
+        from htetro_opt.viz import plot_ga_plan, plot_path, save_figure
 
-        status = "reached" if plan.reached else f"goal NOT reached (leg {plan.failed_leg + 1} has no path)"
-        title = f"{scenario.name}: {args.method}, time {plan.time:g}, {len(plan.tokens)} commands, {status}"
-        save_figure(plot_path(scenario.workspace, plan.poses, roadmap=scenario.roadmap,
-                              hidden=scenario.hidden, title=title), args.plot)
+        method = f"{args.method} ({args.algorithm}, n_pop {args.pop_size}, seed {args.seed})" if genetic else args.method
+        status = "reached" if plan.reached else f"goal NOT reached (leg {plan.failed_leg + 1} {'not solved' if genetic else 'has no path'})"
+        title = f"{scenario.name}: {method}, time {plan.time:g}, {len(plan.tokens)} commands, {status}"
+        if genetic:
+            figure = plot_ga_plan(scenario.workspace, plan, roadmap=scenario.roadmap, hidden=scenario.hidden, title=title)
+        else:
+            figure = plot_path(scenario.workspace, plan.poses, roadmap=scenario.roadmap, hidden=scenario.hidden, title=title)
+        save_figure(figure, args.plot)
     if not args.json:
         legs = len(scenario.roadmap) - 1
-        status = "reached" if plan.reached else f"NOT reached: leg {plan.failed_leg + 1} of {legs} has no path"
+        failure = "was not solved" if genetic else "has no path"
+        status = "reached" if plan.reached else f"NOT reached: leg {plan.failed_leg + 1} of {legs} {failure}"
         print(f"{scenario.name}: {status} ({args.method}, {runtime:.3f} s); time {plan.time:g}, "
               f"{len(plan.tokens)} commands")
+        if genetic:
+            fitness = ", ".join(f"{k} {v:.3f}" for k, v in out["fitness"].items())
+            print(f"generations {out['generations']}, goal first reached in generation {out['reach_generation']}; "
+                  f"multi-objective solution: {fitness}; leading front: {len(out['front'])} members")
         if plan.tokens:
             print(" ".join(plan.tokens))
     return out
+
+
+def _ga_fields(plan, args) -> dict:
+    """The GA's extra JSON fields: the last leg's front, and every leg's record."""
+    legs = [
+        {
+            "start": leg.start.as_dict(),
+            "goal": leg.goal.as_dict(),
+            "reached": leg.reached,
+            "reach_generation": leg.reach_generation,
+            "generations": leg.generations,
+            "converged": leg.converged,
+            "runtime_s": round(leg.runtime_s, 6),
+            "selected": {name: member.as_dict() for name, member in leg.selected.items()},
+            "front": [member.as_dict() for member in leg.front],
+        }
+        for leg in plan.legs
+    ]
+    fitness = np.mean([leg.selected["multi_objective"].fitness for leg in plan.legs], axis=0)
+    return {
+        "algorithm": args.algorithm,
+        "pop_size": args.pop_size,
+        "seed": args.seed,
+        "reach_generation": plan.reach_generation,
+        "generations": sum(leg.generations for leg in plan.legs),
+        "fitness": {name: float(v) for name, v in zip(FITNESS_NAMES, fitness)},
+        "front": legs[-1]["front"],
+        "legs": legs,
+    }
 
 
 def _cmd_simulate(args) -> dict:

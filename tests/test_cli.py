@@ -378,3 +378,82 @@ def test_simulate_runs_in_the_true_world_and_plan_in_the_known_map(capsys, tmp_p
     assert plan["reached"] is True and plan["commands"] == ["x+"] * 4
     out = run_json(capsys, ["simulate", path, "--commands", ",".join(plan["commands"]), "--json"])
     assert out["valid"] is False and out["executed"] == 0 and out["reached"] is False  # x+ reaches x = 4
+
+
+# --------------------------------------------------------------------------------------------------
+# plan --method nsga2 (seed 000's GA)
+
+GA_FAST = ["--method", "nsga2", "--pop-size", "16", "--max-gen", "60", "--patience", "20", "--max-length", "20"]
+
+
+@pytest.fixture(scope="module")
+def ga_out(room):
+    import io
+    from contextlib import redirect_stderr, redirect_stdout
+
+    out, err = io.StringIO(), io.StringIO()
+    near_goal = Path(room).with_name("ga_room.toml")
+    scenario(near_goal, roadmap=pose(2, 2, "O") + pose(6, 4, "O"))
+    with redirect_stdout(out), redirect_stderr(err):
+        code = main(["plan", str(near_goal), *GA_FAST, "--seed", "4", "--json"])
+    assert code == 0 and err.getvalue() == ""
+    return str(near_goal), json.loads(out.getvalue())
+
+
+def test_plan_nsga2_json_fields(ga_out):
+    _, out = ga_out
+    exact_keys = {"scenario", "method", "reached", "commands", "time", "objectives", "runtime_s"}
+    assert exact_keys <= set(out)
+    assert {"reach_generation", "front", "legs", "fitness", "generations"} <= set(out)
+    assert out["method"] == "nsga2" and out["algorithm"] == "htetro"
+    assert out["reached"] is True and out["fitness"]["f_gr"] == 1.0
+    assert 1 <= out["reach_generation"] <= out["generations"]
+    assert out["front"], "the leading front is listed"
+    for member in out["front"]:
+        assert set(member["fitness"]) == {"f_gr", "f_t", "f_sm", "f_sf"}
+        assert member["fitness"]["f_gr"] == 1.0  # F0 holds goal-reaching individuals once one exists
+        assert member["time"] == pytest.approx(sum(1.0 if t[0] in "xy" else 2.0 if t[0] == "r" else 3.0
+                                                   for t in member["commands"]))
+    # The selected (multi-objective) solution is what `commands` holds, and it is a front member.
+    selected = out["legs"][0]["selected"]["multi_objective"]
+    assert selected["commands"] == out["commands"]
+    assert selected["commands"] in [m["commands"] for m in out["front"]]
+
+
+def test_plan_nsga2_commands_replay_in_simulate(capsys, ga_out):
+    path, out = ga_out
+    replay = run_json(capsys, ["simulate", path, "--commands", ",".join(out["commands"]), "--json"])
+    assert replay["valid"] and replay["reached"]
+    assert replay["time"] == pytest.approx(out["time"])
+
+
+def test_plan_nsga2_same_seed_same_plan(capsys, ga_out):
+    path, out = ga_out
+    again = run_json(capsys, ["plan", path, *GA_FAST, "--seed", "4", "--json"])
+    assert again["commands"] == out["commands"] and again["front"] == out["front"]
+
+
+def test_plan_nsga2_text_and_plot(capsys, tmp_path, ga_out):
+    path, _ = ga_out
+    png = tmp_path / "ga.png"
+    code, out, err = run(capsys, ["plan", path, *GA_FAST, "--seed", "4", "--plot", str(png)])
+    assert code == 0 and err == ""
+    assert "reached" in out and "generations" in out and "leading front" in out
+    assert png.read_bytes().startswith(PNG_SIGNATURE)
+
+
+@pytest.mark.parametrize("algorithm", ["nsga2", "nsga3"])
+def test_plan_nsga2_with_pymoo_algorithms(capsys, ga_out, algorithm):
+    path, _ = ga_out
+    out = run_json(capsys, ["plan", path, *GA_FAST, "--algorithm", algorithm, "--json"])
+    assert out["algorithm"] == algorithm and out["front"]
+
+
+@pytest.mark.parametrize("option,value", [("--pop-size", "1"), ("--max-gen", "0"), ("--patience", "0"),
+                                          ("--max-length", "0")])
+def test_plan_nsga2_bad_options_are_one_error_line(capsys, near, option, value):
+    assert_one_error_line(*run(capsys, ["plan", near, "--method", "nsga2", option, value]), option, value)
+
+
+def test_plan_nsga2_unknown_algorithm_is_a_usage_error(capsys, near):
+    assert_one_error_line(*run(capsys, ["plan", near, "--method", "nsga2", "--algorithm", "moead"]), "moead")

@@ -94,12 +94,14 @@ def select_solutions(F: np.ndarray) -> dict[str, int]:
 
 @dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
 class FrontMember:
-    """One individual: its executed commands (global ids), fitnesses and time."""
+    """One individual: its executed commands (global ids), fitnesses, time and the poses it visits
+    ((x, y, state, heading) rows, its leg's start first)."""
 
     commands: np.ndarray
     fitness: np.ndarray  # (f_gr, f_t, f_sm, f_sf)
     time: float
     reached: bool
+    poses: np.ndarray
 
     @property
     def tokens(self) -> list[str]:
@@ -239,7 +241,7 @@ def _n_directions(n_obj: int, partitions: int) -> int:
 def _member(problem: CommandPathProblem, x: np.ndarray, f: np.ndarray) -> FrontMember:
     result = problem.simulate([x])
     return FrontMember(commands=result.prefix(0), fitness=-np.asarray(f, dtype=float),
-                       time=float(result.time[0]), reached=bool(result.reached[0]))
+                       time=float(result.time[0]), reached=bool(result.reached[0]), poses=result.poses(0))
 
 
 def plan_ga(

@@ -12,7 +12,7 @@ from htetro_opt.errors import HtetroError
 from htetro_opt.model.robot import FOOTPRINTS, SHAPES, STATE_NAMES, Pose, shape_index
 from htetro_opt.model.workspace import Workspace
 
-__all__ = ["SHAPE_COLOURS", "plot_path", "save_figure"]
+__all__ = ["SHAPE_COLOURS", "SELECTION_STYLES", "plot_path", "plot_ga_plan", "save_figure"]
 
 SHAPE_COLOURS = {
     "I": "#1f77b4", "O": "#ff7f0e", "L": "#2ca02c", "J": "#d62728",
@@ -121,6 +121,81 @@ def plot_path(
     ax.set_ylabel("y (cells)")
     if title:
         ax.set_title(title, fontsize=10)
+    return fig
+
+
+SELECTION_STYLES = {
+    "multi_objective": ("black", "multi-objective (max Σ f)"),
+    "time": ("#1f77b4", "best f_t"),
+    "smoothness": ("#2ca02c", "best f_sm"),
+    "safety": ("#9467bd", "best f_sf"),
+}
+"""Colour and legend label of each of the paper's four output solutions (Fig. 9)."""
+
+_FITNESS_STYLES = (("f_gr", "black"), ("f_t", "#1f77b4"), ("f_sm", "#2ca02c"), ("f_sf", "#9467bd"))
+
+
+def plot_ga_plan(workspace: Workspace, plan, *, roadmap: tuple[Pose, ...] = (), hidden=None, title: str = ""):
+    """The paper's Figs. 9 and 10 for a GA plan: the four selected paths, and convergence.
+
+    Parameters
+    ----------
+    workspace : Workspace
+    plan : GAPlan
+        From :func:`~htetro_opt.solvers.plan_ga`: the chained multi-objective solution's ``poses``
+        and, per leg, ``selected`` members (with ``poses``) and ``history``.
+    roadmap, hidden, title : keyword-only
+        As for :func:`plot_path`.
+
+    Returns
+    -------
+    matplotlib Figure
+        Left: the map, the multi-objective path's footprints, and the B2 tracks of the four
+        selections (offset slightly so overlapping tracks stay visible). Right: the multi-objective
+        solution's four fitnesses per generation, legs one after another.
+    """
+    plt = _pyplot()
+    aspect = workspace.height / workspace.width
+    fig, (ax_map, ax_fit) = plt.subplots(
+        1, 2, figsize=(13.5, max(3.5, 6.0 * aspect) + 0.8), constrained_layout=True,
+        gridspec_kw={"width_ratios": [1.35, 1.0]},
+    )
+    plot_path(workspace, plan.poses, roadmap=roadmap, hidden=hidden, ax=ax_map)
+    for line in list(ax_map.lines):  # the generic B2 path is replaced by the four coloured tracks
+        line.remove()
+    for k, (name, (colour, label)) in enumerate(SELECTION_STYLES.items()):
+        offset = (k - 1.5) * 0.08
+        for j, leg in enumerate(plan.legs):
+            member = leg.selected.get(name)
+            if member is None or not len(member.poses):
+                continue
+            ax_map.plot(member.poses[:, 0] + offset, member.poses[:, 1] + offset, color=colour,
+                        linewidth=2.2 if name == "multi_objective" else 1.3, label=label if j == 0 else None,
+                        zorder=4 if name == "multi_objective" else 3)
+    handles, labels = ax_map.get_legend_handles_labels()
+    old = ax_map.get_legend()
+    extra = list(old.legend_handles) if old is not None else []
+    ax_map.legend(handles=extra + handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
+    if title:
+        ax_map.set_title(title, fontsize=10)
+
+    start = 1
+    for j, leg in enumerate(plan.legs):
+        history = np.asarray(leg.history).reshape(-1, 4)
+        gens = np.arange(start, start + len(history))
+        for i, (name, colour) in enumerate(_FITNESS_STYLES):
+            ax_fit.plot(gens, history[:, i], color=colour, linewidth=1.4, label=name if j == 0 else None)
+        if leg.reach_generation is not None:
+            ax_fit.axvline(start + leg.reach_generation - 1, color="red", linestyle=":", linewidth=1.0,
+                           label="goal first reached" if j == 0 else None)
+        if j:
+            ax_fit.axvline(start - 0.5, color="#888888", linestyle="--", linewidth=0.8)
+        start += len(history)
+    ax_fit.set_xlabel("generation" + (" (legs one after another)" if len(plan.legs) > 1 else ""))
+    ax_fit.set_ylabel("fitness of the multi-objective solution")
+    ax_fit.set_title("convergence (Fig. 10)", fontsize=10)
+    ax_fit.grid(alpha=0.3)
+    ax_fit.legend(fontsize=8, loc="lower right")
     return fig
 
 
