@@ -88,6 +88,11 @@ class SimulationResult:
         """The executed prefix of sequence i, as global command ids."""
         return self.simulator.command_ids[self.local[i, : self.executed[i]]]
 
+    def sequence(self, i: int) -> np.ndarray:
+        """The whole of sequence i as run (with ``repair``, the repaired commands), as global command ids."""
+        row = self.local[i]
+        return self.simulator.command_ids[row[row != self.simulator.pad]]
+
     def poses(self, i: int) -> np.ndarray:
         """Poses visited by sequence i, start included: shape (executed + 1, 4) of (x, y, state, heading)."""
         return self.simulator.decode(self.trace[i, : self.executed[i] + 1])
@@ -325,6 +330,7 @@ class Simulator:
         roadmap: Sequence[Pose] | None = None,
         t0: int = 0,
         stop_at_goal: bool = False,
+        repair: np.random.Generator | None = None,
     ) -> SimulationResult:
         """Simulate a batch of command sequences from one start pose.
 
@@ -341,6 +347,10 @@ class Simulator:
             Time index (commands already executed) at the start, for moving obstacles.
         stop_at_goal : bool, keyword-only
             End each sequence when it reaches the goal (seed 000's child termination).
+        repair : numpy.random.Generator, optional, keyword-only
+            Replace every command that would be invalid where it is executed by one drawn uniformly
+            from the commands valid there (a sequence dies only where none is); the result's
+            ``local`` (and :meth:`SimulationResult.sequence`) hold the repaired commands.
 
         Returns
         -------
@@ -356,7 +366,10 @@ class Simulator:
         start_id = start if isinstance(start, (int, np.integer)) else self.check_pose(start, what="start", t=t0)
         goals = np.array([self.encode(p) for p in roadmap], dtype=np.int64) if roadmap else np.empty(0, np.int64)
         local, lengths = self._local_commands(sequences)
-        keys = self._step_all(local, lengths, start_id * self.n_columns, t0)
+        if repair is None:
+            keys = self._step_all(local, lengths, start_id * self.n_columns, t0)
+        else:
+            keys, local = self._step_all_repairing(local, lengths, start_id * self.n_columns, t0, repair)
         return self._summarise(keys, local, lengths, goals * self.n_columns, stop_at_goal)
 
     def _step_all(self, local: np.ndarray, lengths: np.ndarray, start_key: int, t0: int) -> np.ndarray:
@@ -382,6 +395,57 @@ class Simulator:
                     at = np.searchsorted(blocked, index).clip(max=len(blocked) - 1)
                     keys[t + 1][blocked[at] == index] = dead_key
         return keys
+
+    @cached_property
+    def _valid_columns(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per pose, its valid command columns first (``(n_poses, C)``) and how many there are."""
+        valid = self.next[: self.n_poses, : self.n_commands] != self.dead
+        order = np.argsort(~valid, axis=1, kind="stable").astype(np.int16)
+        return order, valid.sum(axis=1)
+
+    def _step_all_repairing(self, local, lengths, start_key, t0, rng) -> tuple[np.ndarray, np.ndarray]:
+        """As :meth:`_step_all`, replacing each invalid command by a random valid one; also returns
+        the repaired (B, L) local commands. (Padding never dies, so it is never repaired.)"""
+        batch, width = local.shape
+        flat = self._flat_next
+        dead_key = self.dead * self.n_columns
+        columns = self.n_columns
+        steps = np.array(local.T, dtype=flat.dtype, order="C")
+        keys = np.empty((width + 1, batch), dtype=flat.dtype)
+        keys[0] = start_key
+        index = np.empty(batch, dtype=flat.dtype)
+        order, count = self._valid_columns
+        all_columns = np.arange(self.n_commands, dtype=flat.dtype)
+        moving = bool(self.workspace.moving)
+        for t in range(width):
+            if t % 8 == 0 and t and not (keys[t] != dead_key).any():
+                keys[t + 1 :] = keys[t]
+                break
+            np.add(keys[t], steps[t], out=index)
+            flat.take(index, out=keys[t + 1])
+            blocked = self.blocked_keys(t0 + t) if moving else None
+            if blocked is not None and len(blocked):
+                at = np.searchsorted(blocked, index).clip(max=len(blocked) - 1)
+                keys[t + 1][blocked[at] == index] = dead_key
+            bad = np.flatnonzero((keys[t + 1] == dead_key) & (keys[t] != dead_key))
+            if not len(bad):
+                continue
+            here = keys[t][bad]
+            if blocked is None or not len(blocked):
+                n_valid = count[here // columns]
+                bad, here, n_valid = bad[n_valid > 0], here[n_valid > 0], n_valid[n_valid > 0]
+                pick = order[here // columns, (rng.random(len(bad)) * n_valid).astype(np.int64)].astype(flat.dtype)
+            else:  # the static table does not know the moving obstacles: test every command
+                candidates = here[:, None] + all_columns[None, :]
+                ok = flat[candidates] != dead_key
+                at = np.searchsorted(blocked, candidates).clip(max=len(blocked) - 1)
+                ok &= blocked[at] != candidates
+                pick = np.where(ok, rng.random(ok.shape), -1.0).argmax(axis=1).astype(flat.dtype)
+                fixable = ok.any(axis=1)
+                bad, here, pick = bad[fixable], here[fixable], pick[fixable]
+            steps[t, bad] = pick
+            keys[t + 1, bad] = flat[here + pick]
+        return keys, steps.T.astype(np.int64)
 
     def _summarise(self, keys, local, lengths, goal_keys, stop_at_goal) -> SimulationResult:
         """Per-sequence outcome from the (L + 1, B) keys of a run."""

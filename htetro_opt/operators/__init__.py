@@ -8,6 +8,8 @@ takes the ``random_state`` pymoo passes:
 - :mod:`.crossover`: single-point crossover of variable-length parents (:class:`CommandCrossover`);
 - :mod:`.removal` and :mod:`.rearrangement`: the conservative operators, which never change B2's
   total displacement (:class:`CommandRemoval`, :class:`CommandRearrangement`);
+- :mod:`.repair`: ours, optional: invalid commands replaced by valid ones (:class:`CommandRepair`);
+- :mod:`.shortcut`: ours, optional: cut the longest loop of a path (:class:`CommandShortcut`);
 - :mod:`.duplicates`: :class:`CommandDuplicateElimination`;
 - :mod:`.selection`: the size-4 deterministic tournament on rank and crowding;
 - :mod:`.survival`: the goal-reachability sort (:class:`GoalReachabilitySurvival`).
@@ -18,7 +20,9 @@ from htetro_opt.operators.crossover import CommandCrossover, single_point_crosso
 from htetro_opt.operators.duplicates import CommandDuplicateElimination, chromosome_key
 from htetro_opt.operators.mutation import CommandMutation, mutate_commands
 from htetro_opt.operators.rearrangement import CommandRearrangement, rearrange_commands
+from htetro_opt.operators.repair import CommandRepair
 from htetro_opt.operators.removal import CommandRemoval, remove_commands
+from htetro_opt.operators.shortcut import CommandShortcut, cut_longest_loop
 from htetro_opt.operators.sampling import DEFAULT_WEIGHTS, CommandSampling, sample_commands
 from htetro_opt.operators.selection import RankAndCrowdingTournament, rank_and_crowding_tournament
 from htetro_opt.operators.survival import GoalReachabilitySurvival, reaches_goal
@@ -30,6 +34,8 @@ __all__ = [
     "CommandMutation", "mutate_commands",
     "CommandRearrangement", "rearrange_commands",
     "CommandRemoval", "remove_commands",
+    "CommandRepair",
+    "CommandShortcut", "cut_longest_loop",
     "DEFAULT_WEIGHTS", "CommandSampling", "sample_commands",
     "RankAndCrowdingTournament", "rank_and_crowding_tournament",
     "GoalReachabilitySurvival", "reaches_goal",

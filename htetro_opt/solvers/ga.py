@@ -27,6 +27,7 @@ from htetro_opt.operators import (
     CommandCrossover,
     CommandDuplicateElimination,
     CommandMutation,
+    CommandRepair,
     CommandSampling,
 )
 from htetro_opt.problems.command_path import FITNESS_NAMES, CommandPathProblem
@@ -46,8 +47,9 @@ __all__ = [
     "select_solutions",
 ]
 
-GA_ALGORITHMS = ("htetro", "nsga2", "nsga3", "smsemoa", "agemoea")
-"""Algorithm names :func:`make_algorithm` knows: the paper's hTetro-GA and four of pymoo's."""
+GA_ALGORITHMS = ("htetro", "htetro-paper", "nsga2", "nsga3", "smsemoa", "agemoea")
+"""Algorithm names :func:`make_algorithm` knows: the hTetro-GA with our additions, as published, and
+four of pymoo's."""
 
 SELECTIONS = ("multi_objective", "time", "smoothness", "safety")
 """The paper's four output solutions: largest fitness sum in F0, then best f_t, f_sm, f_sf."""
@@ -183,10 +185,11 @@ def make_algorithm(
 
     Parameters
     ----------
-    name : {"htetro", "nsga2", "nsga3", "smsemoa", "agemoea"}
-        ``"htetro"`` is the paper's :class:`HTetroGA`; the others are pymoo's algorithms with the
-        command sampling, single-point crossover (rate ``crossover_rate``), mutation and duplicate
-        elimination (NSGA-III with Das–Dennis reference directions, about ``pop_size`` of them).
+    name : {"htetro", "htetro-paper", "nsga2", "nsga3", "smsemoa", "agemoea"}
+        ``"htetro"`` is :class:`HTetroGA` with our repair, shortcut and niching, ``"htetro-paper"``
+        :meth:`HTetroGA.as_published`; the others are pymoo's algorithms with the command sampling,
+        single-point crossover (rate ``crossover_rate``), mutation, duplicate elimination and the
+        repair (NSGA-III with Das–Dennis reference directions, about ``pop_size`` of them).
     pop_size : int
     sampling_weights : mapping of token to float, optional
         λ_mc of Algorithm 1.
@@ -204,11 +207,14 @@ def make_algorithm(
     sampling = CommandSampling(sampling_weights)
     if name == "htetro":
         return HTetroGA(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate)
+    if name == "htetro-paper":
+        return HTetroGA.as_published(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate)
     operators = dict(
         sampling=sampling,
         crossover=CommandCrossover(prob=crossover_rate),
         mutation=CommandMutation(),
         eliminate_duplicates=CommandDuplicateElimination(),
+        repair=CommandRepair(),
     )
     if name == "nsga2":
         from pymoo.algorithms.moo.nsga2 import NSGA2
@@ -346,7 +352,7 @@ def plan_ga(
             selected=selected,
             reach_generation=recorder.reach_generation,
             reach_time_s=recorder.reach_time_s,
-            generations=int(res.algorithm.n_gen),
+            generations=len(recorder.history),
             converged=termination.converged,
             runtime_s=_time.perf_counter() - leg_began,
             history=np.array(recorder.history),

@@ -1,0 +1,17 @@
+"""Studies: the papers' experiments re-run on this project's solvers, with their published figures beside ours.
+
+- :mod:`htetro_opt.studies.table4`: seed 000's Table 4 (hTetro-GA over six environments and three
+  population sizes), plus the gap of every GA plan to the exact minimum-time plan.
+- :mod:`htetro_opt.studies.metrics`: mean ± standard deviation aggregation over trial records.
+
+Studies may use the model, problems, solvers and scenarios, never the plotting or the command line.
+"""
+
+from htetro_opt.studies.metrics import (
+    format_mean_std,
+    group_records,
+    mean_std,
+    values_of,
+)
+
+__all__ = ["format_mean_std", "group_records", "mean_std", "values_of"]

@@ -1,0 +1,144 @@
+"""Our additions to the hTetro-GA: the repairing simulation, the repair and shortcut operators."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from htetro_opt.model import SEED000_COMMANDS, MovingObstacle, Pose, Simulator, Workspace, parse_commands
+from htetro_opt.operators import CommandRepair, CommandShortcut, as_column, cut_longest_loop, displacement
+from htetro_opt.problems import CommandPathProblem
+
+SEED_IDS = parse_commands(",".join(SEED000_COMMANDS))
+
+
+def cluttered(seed: int = 0, size: int = 12) -> Workspace:
+    rng = np.random.default_rng(seed)
+    occ = rng.random((size, size)) < 0.15
+    occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
+    occ[1:4, 1:4] = False
+    occ[8:11, 8:11] = False
+    return Workspace(occ)
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(seed=st.integers(0, 2**32 - 1), map_seed=st.integers(0, 20))
+def test_repaired_sequences_are_valid_and_change_only_invalid_commands(seed, map_seed, successors):
+    ws = cluttered(map_seed)
+    sim = Simulator(ws)
+    rng = np.random.default_rng(seed)
+    seqs = [rng.choice(SEED_IDS, size=int(rng.integers(0, 40))) for _ in range(12)]
+    start = Pose(2, 2, "O", 0)
+    result = sim.run(seqs, start, repair=np.random.default_rng(seed))
+    plain = sim.run([result.sequence(i) for i in range(len(seqs))], start)
+    for i, original in enumerate(seqs):
+        repaired = result.sequence(i)
+        assert len(repaired) == len(original)
+        if result.valid[i]:
+            assert plain.valid[i] and plain.executed[i] == len(original)  # the repaired sequence runs whole
+        # every changed command was invalid where it stood, and its replacement is valid there
+        poses = plain.poses(i)
+        tokens = [SEED000_COMMANDS[list(SEED_IDS).index(c)] for c in repaired]
+        original_tokens = [SEED000_COMMANDS[list(SEED_IDS).index(c)] for c in original]
+        for t in range(plain.executed[i]):
+            here = tuple(int(v) for v in poses[t])
+            valid_here = {tok for tok, _, _ in successors(ws, here, t, SEED000_COMMANDS)}
+            assert tokens[t] in valid_here
+            if tokens[t] != original_tokens[t]:
+                assert original_tokens[t] not in valid_here
+
+
+def test_repair_is_reproducible_and_leaves_valid_sequences_alone():
+    sim = Simulator(cluttered(3))
+    seqs = [np.random.default_rng(k).choice(SEED_IDS, size=30) for k in range(8)]
+    a = sim.run(seqs, Pose(2, 2, "O", 0), repair=np.random.default_rng(7))
+    b = sim.run(seqs, Pose(2, 2, "O", 0), repair=np.random.default_rng(7))
+    assert all(np.array_equal(a.sequence(i), b.sequence(i)) for i in range(8))
+    fine = [a.sequence(i)[: a.executed[i]] for i in range(8)]
+    c = sim.run(fine, Pose(2, 2, "O", 0), repair=np.random.default_rng(99))
+    assert all(np.array_equal(c.sequence(i), fine[i]) for i in range(8))
+
+
+def test_repair_respects_moving_obstacles():
+    occ = np.zeros((9, 9), dtype=bool)
+    occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
+    wall = MovingObstacle(cells=((6, 3),), route=((0, 0), (0, 1), (0, 2), (0, 1)), speed=1)
+    ws = Workspace(occ, moving=(wall,))
+    sim = Simulator(ws)
+    seqs = [np.full(12, SEED_IDS[0])]  # x+ repeatedly into the moving block's lane
+    for seed in range(10):
+        result = sim.run(seqs, Pose(1, 3, "O", 0), repair=np.random.default_rng(seed))
+        replay = sim.run([result.sequence(0)], Pose(1, 3, "O", 0))
+        assert replay.executed[0] == result.executed[0]
+        assert replay.valid[0] == result.valid[0]
+
+
+def test_sequence_drops_the_padding():
+    sim = Simulator(Workspace(np.zeros((6, 6), dtype=bool)))
+    result = sim.run([parse_commands("x+"), parse_commands("x+,y+,x-")], Pose(1, 1, "O", 0))
+    assert result.sequence(0).tolist() == parse_commands("x+").tolist()
+    assert result.sequence(1).tolist() == parse_commands("x+,y+,x-").tolist()
+
+
+def test_repair_operator_uses_the_problem_start_and_the_given_random_state():
+    ws = cluttered(5)
+    problem = CommandPathProblem(ws, Pose(2, 2, "O", 0), Pose(8, 8, "O", 0), max_length=30)
+    X = as_column(np.random.default_rng(k).choice(SEED_IDS, size=30) for k in range(10))
+    np.random.seed(0)
+    reference = np.random.random()
+    np.random.seed(0)
+    Y1 = CommandRepair()._do(problem, X, random_state=np.random.default_rng(1))
+    assert np.random.random() == reference
+    Y2 = CommandRepair()._do(problem, X, random_state=np.random.default_rng(1))
+    assert all(np.array_equal(a[0], b[0]) for a, b in zip(Y1, Y2))
+    result = problem.simulator.run([y[0] for y in Y1], problem.start_id)
+    assert result.valid.mean() > 0.5
+
+
+@pytest.mark.parametrize("trace,executed,expected", [
+    ([1, 2, 3, 4], 3, None),
+    ([1, 2, 1], 2, (0, 2)),
+    ([5, 6, 7, 6, 5, 8], 5, (0, 4)),
+    ([5, 6, 7, 6, 9, 8], 5, (1, 3)),
+    ([5, 6, 7, 6, 9, 5], 3, (1, 3)),  # steps after `executed` are not part of the path
+])
+def test_cut_longest_loop(trace, executed, expected):
+    assert cut_longest_loop(np.array(trace), executed) == expected
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_shortcut_keeps_the_end_pose_and_never_lengthens(seed):
+    ws = cluttered(seed % 7)
+    problem = CommandPathProblem(ws, Pose(2, 2, "O", 0), Pose(9, 9, "O", 0), max_length=40)
+    rng = np.random.default_rng(seed)
+    # valid walks that wander (repaired), so they hold loops
+    walks = problem.simulator.run([rng.choice(SEED_IDS, size=40) for _ in range(10)], problem.start_id, repair=rng)
+    X = as_column(walks.sequence(i)[: walks.executed[i]] for i in range(10))
+    Y = CommandShortcut()._do(problem, X, random_state=rng)
+    before = problem.simulate([x[0] for x in X])
+    after = problem.simulate([y[0] for y in Y])
+    for i in range(10):
+        assert len(Y[i, 0]) <= len(X[i, 0])
+        assert displacement(Y[i, 0]) == displacement(X[i, 0])
+        assert after.valid[i]  # a static map: cutting a loop never breaks a path
+        assert tuple(after.final[i]) == tuple(before.final[i])
+        assert after.time[i] <= before.time[i]
+
+
+def test_as_published_switches_every_addition_off():
+    from htetro_opt.operators import CommandRepair as Repair
+    from htetro_opt.solvers import HTetroGA, make_algorithm
+
+    ours, paper = HTetroGA(10), make_algorithm("htetro-paper", 10)
+    assert isinstance(ours.repair, Repair) and ours.shortcut is not None and ours.survival.niche_size == 3
+    assert not isinstance(paper.repair, Repair) and paper.shortcut is None and paper.survival.niche_size == 0
+
+
+def test_pymoo_algorithms_get_the_repair():
+    from htetro_opt.solvers import make_algorithm
+
+    for name in ("nsga2", "nsga3", "smsemoa", "agemoea"):
+        assert isinstance(make_algorithm(name, 12).repair, CommandRepair)
