@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pymoo.core.duplicate import DuplicateElimination
 
-__all__ = ["CommandDuplicateElimination", "chromosome_key"]
+__all__ = ["CommandDuplicateElimination", "chromosome_key", "first_occurrences"]
 
 
 def chromosome_key(x) -> int:
@@ -22,6 +22,26 @@ def chromosome_key(x) -> int:
     if x.dtype == object:
         x = x.ravel()[0]
     return hash(np.asarray(x, dtype=np.int64).tobytes())
+
+
+def first_occurrences(X: np.ndarray, seen: set | None = None) -> np.ndarray:
+    """Rows of a design matrix whose chromosome is neither in ``seen`` (a set of
+    :func:`chromosome_key` values, updated in place) nor in an earlier row.
+
+    Examples
+    --------
+    >>> from htetro_opt.operators import as_column
+    >>> first_occurrences(as_column([[1, 2], [3], [1, 2]])).tolist()
+    [0, 1]
+    """
+    seen = set() if seen is None else seen
+    keep = []
+    for i, x in enumerate(np.asarray(X, dtype=object).reshape(len(X), -1)[:, 0]):
+        key = chromosome_key(x)
+        if key not in seen:
+            seen.add(key)
+            keep.append(i)
+    return np.array(keep, dtype=np.int64)
 
 
 class CommandDuplicateElimination(DuplicateElimination):

@@ -7,14 +7,14 @@ from pymoo.core.mutation import Mutation
 
 from htetro_opt.operators._chromosome import as_column, sequences
 
-__all__ = ["CommandShortcut", "cut_longest_loop"]
+__all__ = ["CommandShortcut", "cut_longest_loop", "longest_loops"]
 
 
 def cut_longest_loop(trace: np.ndarray, executed: int) -> tuple[int, int] | None:
     """The commands ``[i, j)`` to cut so the path skips its longest loop, or None if it has none.
 
     ``trace`` holds the pose ids before and after each command; a loop is a pose visited at step i
-    and again at step j > i, and the executed path with commands i … j − 1 removed passes through
+    and again at step j > i (the longest; the earliest among equally long ones), and the executed path with commands i … j − 1 removed passes through
     the same poses before i and from j on.
 
     Examples
@@ -23,13 +23,50 @@ def cut_longest_loop(trace: np.ndarray, executed: int) -> tuple[int, int] | None
     (0, 4)
     """
     poses = np.asarray(trace[: executed + 1])
-    if len(poses) < 3:
+    if len(poses) < 2:
         return None
     values, first = np.unique(poses, return_index=True)
     last = len(poses) - 1 - np.unique(poses[::-1], return_index=True)[1]
     span = last - first
-    k = int(np.argmax(span))
-    return (int(first[k]), int(last[k])) if span[k] > 0 else None
+    if span.max() <= 0:
+        return None
+    k = int(np.argmin(np.where(span == span.max(), first, len(poses))))  # the earliest of the longest
+    return int(first[k]), int(last[k])
+
+
+def longest_loops(trace: np.ndarray, executed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`cut_longest_loop` for a batch: ``trace`` (B, L + 1), ``executed`` (B,); returns the
+    cut ``(i, j)`` of each row, ``i == j`` where a row has no loop.
+
+    Examples
+    --------
+    >>> longest_loops(np.array([[5, 6, 7, 6, 5, 8], [1, 2, 3, 4, 5, 6]]), np.array([5, 5]))
+    (array([0, 0]), array([4, 0]))
+    """
+    trace = np.asarray(trace)
+    batch, width = trace.shape
+    steps = np.broadcast_to(np.arange(width), trace.shape)
+    rows = np.broadcast_to(np.arange(batch)[:, None], trace.shape)
+    inside = steps <= np.asarray(executed)[:, None]
+    r, p, k = rows[inside], trace[inside], steps[inside]
+    order = np.lexsort((k, p, r))
+    r, p, k = r[order], p[order], k[order]
+    new_group = np.r_[True, (r[1:] != r[:-1]) | (p[1:] != p[:-1])]
+    starts = np.flatnonzero(new_group)
+    ends = np.r_[starts[1:], len(r)] - 1
+    group_row, first, last = r[starts], k[starts], k[ends]
+    span = last - first
+    cut_i, cut_j = np.zeros(batch, dtype=np.int64), np.zeros(batch, dtype=np.int64)
+    best = np.full(batch, -1, dtype=np.int64)
+    # the longest span per row: sort groups by (row, span) and take each row's last
+    by_span = np.lexsort((-first, span, group_row))
+    last_of_row = np.r_[group_row[by_span][1:] != group_row[by_span][:-1], True]
+    chosen = by_span[last_of_row]
+    best[group_row[chosen]] = span[chosen]
+    has_loop = group_row[chosen][span[chosen] > 0]
+    keep = chosen[span[chosen] > 0]
+    cut_i[has_loop], cut_j[has_loop] = first[keep], last[keep]
+    return cut_i, cut_j
 
 
 class CommandShortcut(Mutation):
@@ -49,9 +86,6 @@ class CommandShortcut(Mutation):
         seqs = sequences(X)
         result = problem.simulator.run(seqs, problem.start_id, roadmap=[problem.goal], t0=problem.t0,
                                        stop_at_goal=True)
-        trace = result.keys.T // problem.simulator.n_columns
-        out = []
-        for i, seq in enumerate(seqs):
-            loop = cut_longest_loop(trace[i], int(result.executed[i]))
-            out.append(seq if loop is None else np.concatenate([seq[: loop[0]], seq[loop[1]:]]))
-        return as_column(out)
+        cut_i, cut_j = longest_loops(result.keys.T // problem.simulator.n_columns, result.executed)
+        return as_column(seq if i == j else np.concatenate([seq[:i], seq[j:]])
+                         for seq, i, j in zip(seqs, cut_i.tolist(), cut_j.tolist()))

@@ -45,6 +45,7 @@ from htetro_opt.operators import (
     RankAndCrowdingTournament,
 )
 from htetro_opt.operators._chromosome import as_column
+from htetro_opt.operators.duplicates import chromosome_key, first_occurrences
 
 __all__ = ["HTetroGA", "trim_reached"]
 
@@ -148,38 +149,43 @@ class HTetroGA(GeneticAlgorithm):
                                     random_state=self.random_state)
 
     def _infill(self):
+        # Operators work on the design matrices directly: pymoo's per-individual get/set would cost
+        # more than the whole simulation of both offspring sets.
         problem, pop, rng, mating = self.problem, self.pop, self.random_state, self.mating
-        conservative = Population.new("X", pop.get("X"))
-        conservative = self.removal.do(problem, conservative, random_state=rng)
-        conservative = self.rearrangement.do(problem, conservative, random_state=rng)
+        X = pop.get("X")
+        conservative = self.removal._do(problem, X, random_state=rng)
+        conservative = self.rearrangement._do(problem, conservative, random_state=rng)
         if self.shortcut is not None:
-            conservative = self.shortcut.do(problem, conservative, random_state=rng)
+            conservative = self.shortcut._do(problem, conservative, random_state=rng)
 
         crossing = rng.random(len(pop)) < self.crossover_rate
         n_cross = int(crossing.sum())
-        non_conservative = Population.new("X", pop.get("X")[~crossing])
+        non_conservative = X[~crossing]
         if n_cross:
             matings = mating.selection.do(problem, pop, (n_cross + 1) // 2, n_parents=2,
                                             to_pop=False, random_state=rng)
-            children = mating.crossover.do(problem, pop, matings, random_state=rng)
-            non_conservative = Population.merge(children[:n_cross], non_conservative)
-        non_conservative = mating.mutation.do(problem, non_conservative, random_state=rng)
+            parents = np.stack([X[matings[:, 0]], X[matings[:, 1]]])  # (2, n_matings, 1)
+            children = mating.crossover._do(problem, parents, random_state=rng).reshape(-1, 1)
+            non_conservative = np.concatenate([children[:n_cross], non_conservative])
+        non_conservative = mating.mutation._do(problem, non_conservative, random_state=rng)
 
-        off = Population.merge(conservative, non_conservative)
+        off = np.concatenate([conservative, non_conservative])
         if isinstance(self.repair, CommandRepair):
-            off = self.repair(problem, off, random_state=rng)
-        off = self.eliminate_duplicates.do(off, pop)
+            off = self.repair._do(problem, off, random_state=rng)
+        seen = {chromosome_key(x) for x in X[:, 0]}
+        off = off[first_occurrences(off, seen)]
         if len(off) == 0:
             self.termination.force_termination = True
             return None
-        return off
+        return Population.new("X", off)
 
     def _advance(self, infills=None, **kwargs):
         if infills is None:
             return
         if self.trim_reached:
             trim_reached(infills)
-        merged = self.eliminate_duplicates.do(Population.merge(self.pop, infills))
+        merged = Population.merge(self.pop, infills)
+        merged = merged[first_occurrences(merged.get("X"))]
         self.pop = self.survival.do(self.problem, merged, n_survive=self.pop_size, algorithm=self,
                                     random_state=self.random_state)
 

@@ -142,3 +142,18 @@ def test_pymoo_algorithms_get_the_repair():
 
     for name in ("nsga2", "nsga3", "smsemoa", "agemoea"):
         assert isinstance(make_algorithm(name, 12).repair, CommandRepair)
+
+
+@settings(max_examples=200, deadline=None)
+@given(data=st.data())
+def test_batch_loops_match_the_one_row_version(data):
+    from htetro_opt.operators import longest_loops
+
+    width = data.draw(st.integers(1, 16))
+    rows = data.draw(st.lists(st.lists(st.integers(0, 4), min_size=width, max_size=width), min_size=1, max_size=4))
+    trace = np.array(rows)
+    executed = np.array([data.draw(st.integers(0, width - 1)) for _ in rows])
+    cut_i, cut_j = longest_loops(trace, executed)
+    for r in range(len(rows)):
+        expected = cut_longest_loop(trace[r], int(executed[r]))
+        assert (None if cut_i[r] == cut_j[r] else (int(cut_i[r]), int(cut_j[r]))) == expected
