@@ -44,7 +44,8 @@ from htetro_opt.operators import (
     GoalReachabilitySurvival,
     RankAndCrowdingTournament,
 )
-from htetro_opt.operators._chromosome import as_column
+from htetro_opt.operators._chromosome import as_column, sequences
+from htetro_opt.operators.shortcut import longest_loops
 from htetro_opt.operators.duplicates import chromosome_key, first_occurrences
 
 __all__ = ["HTetroGA", "trim_reached"]
@@ -155,8 +156,6 @@ class HTetroGA(GeneticAlgorithm):
         X = pop.get("X")
         conservative = self.removal._do(problem, X, random_state=rng)
         conservative = self.rearrangement._do(problem, conservative, random_state=rng)
-        if self.shortcut is not None:
-            conservative = self.shortcut._do(problem, conservative, random_state=rng)
 
         crossing = rng.random(len(pop)) < self.crossover_rate
         n_cross = int(crossing.sum())
@@ -170,14 +169,36 @@ class HTetroGA(GeneticAlgorithm):
         non_conservative = mating.mutation._do(problem, non_conservative, random_state=rng)
 
         off = np.concatenate([conservative, non_conservative])
-        if isinstance(self.repair, CommandRepair):
-            off = self.repair._do(problem, off, random_state=rng)
+        off = self._repair_and_shortcut(off, len(conservative))
         seen = {chromosome_key(x) for x in X[:, 0]}
         off = off[first_occurrences(off, seen)]
         if len(off) == 0:
             self.termination.force_termination = True
             return None
         return Population.new("X", off)
+
+    def _repair_and_shortcut(self, off: np.ndarray, n_conservative: int) -> np.ndarray:
+        """Repair every offspring and cut the longest loop of the conservative ones, from one simulation.
+
+        The same as :class:`~htetro_opt.operators.CommandRepair` on all offspring followed by
+        :class:`~htetro_opt.operators.CommandShortcut` on the conservative ones (the loops are
+        found on the repaired paths, so a cut path stays valid on a static map).
+        """
+        repair = isinstance(self.repair, CommandRepair)
+        if not repair and self.shortcut is None:
+            return off
+        problem = self.problem
+        seqs = sequences(off)
+        result = problem.simulator.run(seqs, problem.start_id, roadmap=[problem.goal], t0=problem.t0,
+                                       stop_at_goal=True, repair=self.random_state if repair else None)
+        if repair:
+            seqs = [result.sequence(i) for i in range(len(seqs))]
+        if self.shortcut is not None and n_conservative:
+            trace = result.keys[:, :n_conservative].T // problem.simulator.n_columns
+            cut_i, cut_j = longest_loops(trace, result.executed[:n_conservative])
+            for k in np.flatnonzero(cut_i != cut_j):
+                seqs[k] = np.concatenate([seqs[k][: cut_i[k]], seqs[k][cut_j[k]:]])
+        return as_column(seqs)
 
     def _advance(self, infills=None, **kwargs):
         if infills is None:

@@ -38,6 +38,8 @@ class FrontConvergence(Termination):
         n_pop,max of the paper (1000).
     patience : int
         Generations without improvement that count as convergence.
+    tolerance : float
+        Smallest increase that counts as an improvement.
 
     Attributes
     ----------
