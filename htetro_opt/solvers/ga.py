@@ -295,9 +295,9 @@ def plan_ga(
     Returns
     -------
     GAPlan
-        ``reached`` is False when a leg's final population holds no individual reaching its goal;
-        the plan then stops after that leg's best attempt is *not* appended, and ``failed_leg`` says
-        which leg it was.
+        ``reached`` is False when a leg's final population holds no individual reaching its goal; the
+        plan then holds the legs before it (not the failed leg's best attempt), ``failed_leg`` says
+        which leg failed, and ``legs`` ends with that leg's record.
 
     Raises
     ------
