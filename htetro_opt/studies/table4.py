@@ -248,7 +248,7 @@ def _trial_record(environment: str, pop_size: int, seed: int, algorithm: str, ma
                   patience: int, plan: GAPlan, roadmap: Sequence[Pose], t_max: float) -> dict:
     legs = plan.legs
     reached = bool(plan.reached)
-    generations = [len(leg.history) for leg in legs]  # generations run (LegResult.generations counts one more)
+    generations = [len(leg.history) for leg in legs]  # generations run: one history row each
     mo = [leg.selected["multi_objective"].fitness for leg in legs]
     fitness = np.mean(np.asarray(mo, dtype=float), axis=0) if mo else np.full(4, np.nan)
 
