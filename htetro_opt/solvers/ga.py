@@ -198,7 +198,8 @@ def make_algorithm(
     Raises
     ------
     ParameterError
-        If the name is unknown or ``pop_size`` is below 2.
+        If the name is unknown, ``pop_size`` is below 2, or ``"agemoea"`` is asked for without numba
+        installed (pymoo's AGE-MOEA needs it: the ``agemoea`` extra).
     """
     if name not in GA_ALGORITHMS:
         raise ParameterError(f"unknown algorithm {name!r}: expected one of {', '.join(GA_ALGORITHMS)}")
@@ -233,8 +234,12 @@ def make_algorithm(
         from pymoo.algorithms.moo.sms import SMSEMOA
 
         return SMSEMOA(pop_size=pop_size, **operators)
-    from pymoo.algorithms.moo.age import AGEMOEA
-
+    try:
+        from pymoo.algorithms.moo.age import AGEMOEA
+    except Exception as err:  # pymoo's AGE-MOEA module turns a missing numba into a bare Exception
+        raise ParameterError(
+            f"algorithm 'agemoea' needs numba, which pymoo's AGE-MOEA imports: pip install 'htetro-opt[agemoea]' ({err})"
+        ) from err
     return AGEMOEA(pop_size=pop_size, **operators)
 
 

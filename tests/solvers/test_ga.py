@@ -322,3 +322,12 @@ def test_leg_generations_count_the_generations_run():
     leg = plan.legs[0]
     assert len(leg.history) == 4  # one row per generation: the cap was honoured
     assert leg.generations == len(leg.history) == 4
+
+
+def test_agemoea_without_numba_is_a_clear_error(monkeypatch):
+    import sys
+
+    monkeypatch.delitem(sys.modules, "pymoo.algorithms.moo.age", raising=False)
+    monkeypatch.setitem(sys.modules, "numba", None)  # makes `import numba` fail
+    with pytest.raises(ParameterError, match="numba"):
+        make_algorithm("agemoea", 12)
