@@ -30,7 +30,6 @@ import io
 import math
 import os
 import sys
-import tempfile
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from functools import cache
@@ -39,6 +38,7 @@ from typing import Any
 
 import numpy as np
 
+from htetro_opt._files import atomic_path
 from htetro_opt.errors import ConfigurationError, HtetroError, ParameterError
 from htetro_opt.model.commands import SEED000_COMMANDS
 from htetro_opt.model.robot import Pose
@@ -606,31 +606,14 @@ def markdown_table(summary: Iterable[Mapping[str, Any]]) -> str:
 
 
 # --- files ---------------------------------------------------------------------------------------
-def _umask() -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
 def _write_atomic(path: str | os.PathLike, text: str) -> Path:
-    """Write ``text`` to ``path`` through a temporary file in the same directory and
-    :func:`os.replace`, so that the path never holds a half-written file."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes it private; give it an ordinary file's mode
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
+    """Write ``text`` to ``path`` so that the path never holds a half-written file."""
+    with atomic_path(path) as tmp:
+        with open(tmp, "w", encoding="utf-8", newline="") as handle:
             handle.write(text)
             handle.flush()
             os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
-    return path
+    return Path(path)
 
 
 def _csv_value(value: Any) -> str:

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from htetro_opt._files import atomic_path
 from htetro_opt.errors import HtetroError
 from htetro_opt.model.robot import FOOTPRINTS, SHAPES, STATE_NAMES, Pose, shape_index
 from htetro_opt.model.workspace import Workspace
@@ -213,18 +212,11 @@ def save_figure(fig, path: str | Path, *, dpi: int = 120) -> Path:
     if not directory.is_dir():
         plt.close(fig)
         raise HtetroError(f"cannot write plot {str(path)!r}: directory {str(directory)!r} does not exist")
-    handle, tmp = tempfile.mkstemp(suffix=".png", prefix=".htetro-", dir=directory)
-    os.close(handle)
-    umask = os.umask(0)
-    os.umask(umask)
     try:
-        fig.savefig(tmp, dpi=dpi, format="png")
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes the file private; give it a normal file's mode
-        os.replace(tmp, path)
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=dpi, format="png")
     except OSError as err:
         raise HtetroError(f"cannot write plot {str(path)!r}: {err.strerror or err}") from err
     finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
         plt.close(fig)
     return path
