@@ -40,13 +40,12 @@ from htetro_opt.operators import (
     CommandRemoval,
     CommandRepair,
     CommandSampling,
-    CommandShortcut,
     GoalReachabilitySurvival,
     RankAndCrowdingTournament,
 )
 from htetro_opt.operators._chromosome import as_column, sequences
-from htetro_opt.operators.shortcut import longest_loops
 from htetro_opt.operators.duplicates import chromosome_key, first_occurrences
+from htetro_opt.operators.shortcut import longest_loops
 
 __all__ = ["HTetroGA", "trim_reached"]
 
@@ -135,7 +134,7 @@ class HTetroGA(GeneticAlgorithm):
         self.rearrangement = rearrangement if rearrangement is not None else CommandRearrangement()
         self.crossover_rate = float(crossover_rate)
         self.trim_reached = bool(trim_reached)
-        self.shortcut = CommandShortcut() if shortcut else None
+        self.shortcut = bool(shortcut)
 
     @classmethod
     def as_published(cls, pop_size: int = 50, **kwargs) -> "HTetroGA":
@@ -145,7 +144,7 @@ class HTetroGA(GeneticAlgorithm):
     def _initialize_advance(self, infills=None, **kwargs):
         if self.trim_reached:
             trim_reached(infills)
-        infills = self.eliminate_duplicates.do(infills)
+        infills = infills[first_occurrences(infills.get("X"))]
         self.pop = self.survival.do(self.problem, infills, n_survive=len(infills), algorithm=self,
                                     random_state=self.random_state)
 
@@ -185,7 +184,7 @@ class HTetroGA(GeneticAlgorithm):
         found on the repaired paths, so a cut path stays valid on a static map).
         """
         repair = isinstance(self.repair, CommandRepair)
-        if not repair and self.shortcut is None:
+        if not repair and not self.shortcut:
             return off
         problem = self.problem
         seqs = sequences(off)
@@ -193,7 +192,7 @@ class HTetroGA(GeneticAlgorithm):
                                        stop_at_goal=True, repair=self.random_state if repair else None)
         if repair:
             seqs = [result.sequence(i) for i in range(len(seqs))]
-        if self.shortcut is not None and n_conservative:
+        if self.shortcut and n_conservative:
             trace = result.keys[:, :n_conservative].T // problem.simulator.n_columns
             cut_i, cut_j = longest_loops(trace, result.executed[:n_conservative])
             for k in np.flatnonzero(cut_i != cut_j):

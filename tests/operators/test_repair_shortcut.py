@@ -133,8 +133,8 @@ def test_as_published_switches_every_addition_off():
     from htetro_opt.solvers import HTetroGA, make_algorithm
 
     ours, paper = HTetroGA(10), make_algorithm("htetro-paper", 10)
-    assert isinstance(ours.repair, Repair) and ours.shortcut is not None and ours.survival.niche_size == 3
-    assert not isinstance(paper.repair, Repair) and paper.shortcut is None and paper.survival.niche_size == 0
+    assert isinstance(ours.repair, Repair) and ours.shortcut and ours.survival.niche_size == 3
+    assert not isinstance(paper.repair, Repair) and not paper.shortcut and paper.survival.niche_size == 0
 
 
 def test_pymoo_algorithms_get_the_repair():
