@@ -22,7 +22,7 @@ from htetro_opt.operators.mutation import CommandMutation, mutate_commands
 from htetro_opt.operators.rearrangement import CommandRearrangement, rearrange_commands
 from htetro_opt.operators.repair import CommandRepair
 from htetro_opt.operators.removal import CommandRemoval, remove_commands
-from htetro_opt.operators.shortcut import CommandShortcut, cut_longest_loop, longest_loops
+from htetro_opt.operators.shortcut import CommandShortcut, cut_longest_loop, longest_loops, shortcut_sequences
 from htetro_opt.operators.sampling import DEFAULT_WEIGHTS, CommandSampling, sample_commands
 from htetro_opt.operators.selection import RankAndCrowdingTournament, rank_and_crowding_tournament
 from htetro_opt.operators.survival import GoalReachabilitySurvival, reaches_goal
@@ -35,7 +35,7 @@ __all__ = [
     "CommandRearrangement", "rearrange_commands",
     "CommandRemoval", "remove_commands",
     "CommandRepair",
-    "CommandShortcut", "cut_longest_loop", "longest_loops",
+    "CommandShortcut", "cut_longest_loop", "longest_loops", "shortcut_sequences",
     "DEFAULT_WEIGHTS", "CommandSampling", "sample_commands",
     "RankAndCrowdingTournament", "rank_and_crowding_tournament",
     "GoalReachabilitySurvival", "reaches_goal",

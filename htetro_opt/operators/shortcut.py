@@ -7,7 +7,7 @@ from pymoo.core.mutation import Mutation
 
 from htetro_opt.operators._chromosome import as_column, sequences
 
-__all__ = ["CommandShortcut", "cut_longest_loop", "longest_loops"]
+__all__ = ["CommandShortcut", "cut_longest_loop", "longest_loops", "shortcut_sequences"]
 
 
 def cut_longest_loop(trace: np.ndarray, executed: int) -> tuple[int, int] | None:
@@ -69,6 +69,18 @@ def longest_loops(trace: np.ndarray, executed: np.ndarray) -> tuple[np.ndarray, 
     return cut_i, cut_j
 
 
+def shortcut_sequences(seqs: list[np.ndarray], result, count: int | None = None) -> list[np.ndarray]:
+    """``seqs`` with the longest loop of each of the first ``count`` (default all) cut out, the loops
+    found on ``result``, the :class:`~htetro_opt.model.SimulationResult` of running them."""
+    count = len(seqs) if count is None else count
+    trace = result.keys[:, :count].T // result.simulator.n_columns
+    cut_i, cut_j = longest_loops(trace, result.executed[:count])
+    out = list(seqs)
+    for k in np.flatnonzero(cut_i != cut_j):
+        out[k] = np.concatenate([seqs[k][: cut_i[k]], seqs[k][cut_j[k]:]])
+    return out
+
+
 class CommandShortcut(Mutation):
     """Simulate each chromosome from the problem's start and cut its longest loop (the commands
     between two visits of the same pose), keeping the genes after the executed part.
@@ -86,6 +98,4 @@ class CommandShortcut(Mutation):
         seqs = sequences(X)
         result = problem.simulator.run(seqs, problem.start_id, roadmap=[problem.goal], t0=problem.t0,
                                        stop_at_goal=True)
-        cut_i, cut_j = longest_loops(result.keys.T // problem.simulator.n_columns, result.executed)
-        return as_column(seq if i == j else np.concatenate([seq[:i], seq[j:]])
-                         for seq, i, j in zip(seqs, cut_i.tolist(), cut_j.tolist()))
+        return as_column(shortcut_sequences(seqs, result))

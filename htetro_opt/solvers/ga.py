@@ -249,10 +249,12 @@ def _n_directions(n_obj: int, partitions: int) -> int:
     return comb(partitions + n_obj - 1, n_obj - 1)
 
 
-def _member(problem: CommandPathProblem, x: np.ndarray, f: np.ndarray) -> FrontMember:
-    result = problem.simulate([x])
-    return FrontMember(commands=result.prefix(0), fitness=-np.asarray(f, dtype=float),
-                       time=float(result.time[0]), reached=bool(result.reached[0]), poses=result.poses(0))
+def _members(problem: CommandPathProblem, X: np.ndarray, F: np.ndarray) -> list[FrontMember]:
+    """Front members of the rows of ``X`` (objectives ``F``), from one batch simulation."""
+    result = problem.simulate([x[0] for x in X])
+    return [FrontMember(commands=result.prefix(i), fitness=-np.asarray(F[i], dtype=float),
+                        time=float(result.time[i]), reached=bool(result.reached[i]), poses=result.poses(i))
+            for i in range(len(X))]
 
 
 def plan_ga(
@@ -349,11 +351,12 @@ def plan_ga(
         X, F = res.pop.get("X"), res.pop.get("F")
         chosen = select_solutions(F)
         front_idx = leading_front(F)
-        selected = {name: _member(problem, X[i, 0], F[i]) for name, i in chosen.items()}
+        rows = np.array(list(chosen.values()), dtype=np.int64)
+        selected = dict(zip(chosen, _members(problem, X[rows], F[rows])))
         reached = bool(selected["multi_objective"].reached)
         legs.append(LegResult(
             start=start, goal=goal, t0=t0, reached=reached,
-            front=tuple(_member(problem, X[i, 0], F[i]) for i in front_idx),
+            front=tuple(_members(problem, X[front_idx], F[front_idx])),
             selected=selected,
             reach_generation=recorder.reach_generation,
             reach_time_s=recorder.reach_time_s,

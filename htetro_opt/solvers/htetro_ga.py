@@ -45,7 +45,7 @@ from htetro_opt.operators import (
 )
 from htetro_opt.operators._chromosome import as_column, sequences
 from htetro_opt.operators.duplicates import chromosome_key, first_occurrences
-from htetro_opt.operators.shortcut import longest_loops
+from htetro_opt.operators.shortcut import shortcut_sequences
 
 __all__ = ["HTetroGA", "trim_reached"]
 
@@ -193,10 +193,7 @@ class HTetroGA(GeneticAlgorithm):
         if repair:
             seqs = [result.sequence(i) for i in range(len(seqs))]
         if self.shortcut and n_conservative:
-            trace = result.keys[:, :n_conservative].T // problem.simulator.n_columns
-            cut_i, cut_j = longest_loops(trace, result.executed[:n_conservative])
-            for k in np.flatnonzero(cut_i != cut_j):
-                seqs[k] = np.concatenate([seqs[k][: cut_i[k]], seqs[k][cut_j[k]:]])
+            seqs = shortcut_sequences(seqs, result, n_conservative)
         return as_column(seqs)
 
     def _advance(self, infills=None, **kwargs):
