@@ -7,6 +7,8 @@ from htetro_opt.errors import (
     ParameterError,
     PlanningError,
     ScenarioError,
+    TilesetFormatError,
+    TilingError,
     UnknownCommandError,
     UnknownShapeError,
 )
@@ -23,4 +25,6 @@ __all__ = [
     "UnknownCommandError",
     "PlanningError",
     "ParameterError",
+    "TilesetFormatError",
+    "TilingError",
 ]

@@ -1,7 +1,8 @@
 """The ``htetro-opt`` command line.
 
 Every command takes a SCENARIO, a bundled name (``htetro-opt scenarios`` lists them) or a path to a
-scenario TOML file. Errors print one ``error: …`` line and exit with status 2.
+scenario TOML file; ``sequence`` also takes a labelled tileset (a bundled name, ``htetro-opt
+scenarios`` lists them too, or a file). Errors print one ``error: …`` line and exit with status 2.
 """
 
 from __future__ import annotations
@@ -20,8 +21,27 @@ from htetro_opt.model import Simulator, parse_commands
 from htetro_opt.model.commands import DIAGONAL_COMMANDS, SEED000_COMMANDS
 from htetro_opt.model.robot import STATE_NAMES
 from htetro_opt.problems import FITNESS_NAMES
-from htetro_opt.scenarios import Scenario, list_scenarios, load_scenario
-from htetro_opt.solvers import GA_ALGORITHMS, plan_exact, plan_ga
+from htetro_opt.problems import SequencingInstance, check_weights
+from htetro_opt.scenarios import (
+    Scenario,
+    format_tileset,
+    list_scenarios,
+    list_tilesets,
+    load_scenario,
+    load_tileset,
+    save_tileset,
+    scenario_path,
+    tileset_path,
+)
+from htetro_opt.solvers import (
+    GA_ALGORITHMS,
+    SEQUENCE_SOLVERS,
+    TILING_SOLVERS,
+    plan_exact,
+    plan_ga,
+    sequence_waypoints,
+    tile_workspace,
+)
 
 __all__ = ["main", "main_entry", "build_parser"]
 
@@ -80,6 +100,46 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plot", metavar="FILE", help="save a PNG of the map and the executed path")
+
+    p = sub.add_parser(
+        "tile",
+        help="tile a scenario's free cells with tetrominoes (seed 003) and label the waypoints",
+        description="Tile the free cells of a grid scenario with the robot's tetrominoes and label every "
+        "tile's blocks a-d by Algorithm 1 of seed 003. Writes the labelled tileset (to --out, or prints it).",
+    )
+    p.add_argument("scenario", help="bundled scenario name or path to a scenario TOML file")
+    p.add_argument("--shapes", help="allowed morphologies, e.g. TZ or O (default: all seven, IOLJZST)")
+    p.add_argument("--solver", choices=TILING_SOLVERS, default="backtracking",
+                   help="backtracking: the paper's search (default); cpsat: exact cover with OR-Tools CP-SAT")
+    p.add_argument("--overlap", action="store_true",
+                   help="if the map cannot be tiled, cover it by two overlapping sub-workspaces (seed 003 Fig. 5)")
+    p.add_argument("--seed", type=int, help="shuffle the placement order, for another tiling")
+    p.add_argument("--time-limit", type=float, help="give up after this many seconds")
+    p.add_argument("--out", metavar="FILE", help="write the labelled tileset to FILE")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--plot", metavar="FILE", help="save a PNG of the tileset")
+
+    p = sub.add_parser(
+        "sequence",
+        help="order a tileset's waypoints (seed 003's TSP) with one solver",
+        description="Order the waypoints of a labelled tileset as an open path from a start tile, "
+        "minimising the eq.-2 cost (weighted displacement of the blocks a-d). TILESET is a labelled "
+        "tileset (bundled name or file) or a scenario, which is tiled first.",
+    )
+    p.add_argument("tileset", help="labelled tileset (bundled name or file) or scenario (name or .toml)")
+    p.add_argument("--solver", choices=SEQUENCE_SOLVERS, default="auto",
+                   help="auto (default): exact up to 40 waypoints, local search beyond; ga: the paper's GA "
+                        "on DEAP with a 2-opt/Or-opt step (ga-plain: without); ortools: routing with "
+                        "guided local search; exact: CP-SAT optimum (<= 40 waypoints); local: nearest "
+                        "neighbour + 2-opt/Or-opt; zigzag, zigzag2, spiral, spiral2, greedy: the paper's baselines")
+    p.add_argument("--start", default="1", help="label of the start tile (default 1), or 'free'")
+    p.add_argument("--weights", default="0.25,0.25,0.25,0.25",
+                   help="eq. 2's weights α,β,λ,γ of blocks a,b,c,d (default 0.25 each)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (deterministic solvers ignore it)")
+    p.add_argument("--time-limit", type=float, help="time budget in seconds (exact, ortools, ga, local)")
+    p.add_argument("--shapes", help="when TILESET is a scenario: allowed morphologies for the tiling")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--plot", metavar="FILE", help="save a PNG of the tileset and the order")
     return parser
 
 
@@ -110,12 +170,22 @@ def _cmd_scenarios(args) -> dict:
                          "roadmap": len(sc.roadmap), "moving": len(sc.workspace.moving), "source": sc.source})
         else:
             rows.append({"name": name, "size": [sc.width, sc.height], "roadmap": 0, "moving": 0, "source": sc.source})
+    tilesets = []
+    for name in list_tilesets():
+        ts = load_tileset(tileset_path(name))
+        tilesets.append({"name": name, "size": [ts.width, ts.height], "tiles": len(ts),
+                         "source": "seed 003 (Le et al., Electronics 2018), the paper's labelled tileset"})
     if not args.json:
-        width = max((len(r["name"]) for r in rows), default=4)
+        width = max((len(r["name"]) for r in rows + tilesets), default=4)
         for r in rows:
             size = "x".join(str(v) for v in r["size"])
             print(f"{r['name']:<{width}}  {size:>9}  {r['source']}")
-    return {"scenarios": rows}
+        if tilesets:
+            print("\nlabelled tilesets (for 'sequence'):")
+        for r in tilesets:
+            size = "x".join(str(v) for v in r["size"])
+            print(f"{r['name']:<{width}}  {size:>9}  {r['tiles']} tiles, {r['source']}")
+    return {"scenarios": rows, "tilesets": tilesets}
 
 
 def _cmd_plan(args) -> dict:
@@ -240,7 +310,91 @@ def _cmd_simulate(args) -> dict:
     return out
 
 
-_COMMANDS = {"scenarios": _cmd_scenarios, "plan": _cmd_plan, "simulate": _cmd_simulate}
+def _time_limit(value: float | None) -> float | None:
+    if value is not None and not value > 0:
+        raise ParameterError(f"--time-limit must be positive, got {value:g}")
+    return value
+
+
+def _tileset_of_scenario(name: str, *, shapes, solver="backtracking", seed=None, time_limit=None, overlap=False):
+    scenario = _grid_scenario(name)
+    return tile_workspace(scenario.workspace, shapes=shapes, solver=solver, seed=seed, time_limit=time_limit,
+                          overlap=overlap, name=scenario.name)
+
+
+def _cmd_tile(args) -> dict:
+    time_limit = _time_limit(args.time_limit)
+    shapes = list(args.shapes) if args.shapes else None
+    began = time.perf_counter()
+    tileset = _tileset_of_scenario(args.scenario, shapes=shapes, solver=args.solver, seed=args.seed,
+                                   time_limit=time_limit, overlap=args.overlap)
+    runtime = time.perf_counter() - began
+    if args.out:
+        save_tileset(tileset, args.out)
+    counts = {shape: tileset.shapes.count(shape) for shape in sorted(set(tileset.shapes))}
+    out = {"scenario": tileset.name, "solver": args.solver, "tiles": len(tileset), "shapes": counts,
+           "overlapping": tileset.overlapping, "runtime_s": round(runtime, 6), "out": args.out}
+    if args.plot:
+        from htetro_opt.viz import plot_tileset, save_figure
+
+        save_figure(plot_tileset(tileset, title=f"{tileset.name}: {len(tileset)} tiles ({args.solver})"), args.plot)
+    if args.json:
+        if not args.out:
+            out["tileset"] = format_tileset(tileset)
+    elif args.out:
+        print(f"{tileset.name}: {len(tileset)} tiles in {runtime:.3f} s "
+              f"({', '.join(f'{k} {v}' for k, v in counts.items())}); written to {args.out}")
+    else:
+        print(format_tileset(tileset))
+    return out
+
+
+def _is_scenario(name: str) -> bool:
+    if name.endswith(".toml"):
+        return True
+    if name in list_tilesets():
+        return False
+    return name in list_scenarios()
+
+
+def _cmd_sequence(args) -> dict:
+    time_limit = _time_limit(args.time_limit)
+    try:
+        weights = check_weights([float(v) for v in args.weights.split(",")])
+    except ValueError as err:
+        raise ParameterError(f"--weights must be four comma-separated numbers a,b,c,d, got {args.weights!r}") from err
+    if args.start == "free":
+        start = None
+    else:
+        try:
+            start = int(args.start)
+        except ValueError as err:
+            raise ParameterError(f"--start must be a tile label or 'free', got {args.start!r}") from err
+    if _is_scenario(args.tileset):
+        scenario_path(args.tileset)  # a clear error for a missing file
+        tileset = _tileset_of_scenario(args.tileset, shapes=list(args.shapes) if args.shapes else None)
+    else:
+        if args.shapes:
+            raise ParameterError("--shapes applies only when TILESET is a scenario to tile")
+        tileset = load_tileset(tileset_path(args.tileset))
+    instance = SequencingInstance.from_tileset(tileset, start=start, weights=weights)
+    result = sequence_waypoints(instance, args.solver, seed=args.seed, time_limit=time_limit)
+    out = {"tileset": tileset.name, "waypoints": instance.n, "start": args.start, "weights": weights.tolist(),
+           **result.as_dict()}
+    if args.plot:
+        from htetro_opt.viz import plot_tileset, save_figure
+
+        title = f"{tileset.name}: {result.solver}, cost {result.cost:.3f}"
+        save_figure(plot_tileset(tileset, order=result.tiles, title=title), args.plot)
+    if not args.json:
+        print(f"{tileset.name}: {instance.n} waypoints, {result.solver}, cost {result.cost:.4f} "
+              f"in {result.runtime_s:.3f} s")
+        print(" ".join(str(t) for t in result.tiles))
+    return out
+
+
+_COMMANDS = {"scenarios": _cmd_scenarios, "plan": _cmd_plan, "simulate": _cmd_simulate,
+             "tile": _cmd_tile, "sequence": _cmd_sequence}
 
 
 def main(argv: Sequence[str] | None = None) -> int:

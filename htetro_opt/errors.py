@@ -16,6 +16,8 @@ __all__ = [
     "UnknownCommandError",
     "PlanningError",
     "ParameterError",
+    "TilesetFormatError",
+    "TilingError",
 ]
 
 
@@ -51,6 +53,14 @@ class UnknownCommandError(HtetroError, KeyError):
 
 class PlanningError(HtetroError, RuntimeError):
     """A planner was asked something it cannot do (e.g. an empty roadmap)."""
+
+
+class TilesetFormatError(MapFormatError):
+    """A labelled tileset (seed 003) is malformed: an unknown token, a tile without one of its blocks a–d."""
+
+
+class TilingError(PlanningError):
+    """A workspace cannot be tiled with the allowed tetrominoes (area, parity, an isolated region)."""
 
 
 class ParameterError(HtetroError, ValueError):

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from htetro_opt.cli import main
-from htetro_opt.scenarios import list_scenarios
+from htetro_opt.scenarios import list_scenarios, list_tilesets, load_tileset
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -245,16 +245,18 @@ def test_plot_into_missing_directory(capsys, tmp_path, near, command):
 # scenarios
 
 
-def test_scenarios_json_lists_the_bundled_scenarios(capsys):
+def test_scenarios_json_lists_the_bundled_scenarios_and_tilesets(capsys):
     out = run_json(capsys, ["scenarios", "--json"])
     assert [row["name"] for row in out["scenarios"]] == list_scenarios()
+    assert [row["name"] for row in out["tilesets"]] == list_tilesets()
 
 
 def test_scenarios_text_lists_one_name_per_line(capsys):
     code, out, err = run(capsys, ["scenarios"])
     assert code == 0 and err == ""
-    names = [line.split()[0] for line in out.splitlines() if line.strip()]
-    assert names == list_scenarios()
+    scenarios, tilesets = out.split("labelled tilesets")
+    assert [line.split()[0] for line in scenarios.splitlines() if line.strip()] == list_scenarios()
+    assert [line.split()[0] for line in tilesets.splitlines()[1:] if line.strip()] == list_tilesets()
 
 
 # --------------------------------------------------------------------------------------------------
@@ -457,3 +459,122 @@ def test_plan_nsga2_bad_options_are_one_error_line(capsys, near, option, value):
 
 def test_plan_nsga2_unknown_algorithm_is_a_usage_error(capsys, near):
     assert_one_error_line(*run(capsys, ["plan", near, "--method", "nsga2", "--algorithm", "moead"]), "moead")
+
+
+# --------------------------------------------------------------------------------------------------
+# tile and sequence (seed 003)
+
+STRIP = """\
+........
+........
+...##...
+...##..."""
+
+
+def test_tile_writes_a_labelled_tileset_that_covers_the_map(capsys, tmp_path):
+    path = scenario(tmp_path / "strip.toml", grid=STRIP)
+    out_file = tmp_path / "strip.txt"
+    out = run_json(capsys, ["tile", path, "--out", str(out_file), "--json"])
+    assert out["tiles"] == 7 and out["out"] == str(out_file) and not out["overlapping"]
+    tileset = load_tileset(out_file)
+    assert tileset.complete and not tileset.overlapping and len(tileset) == 7
+    assert all(p is not None for p in tileset.poses)  # written with the robot's footprints
+
+
+def test_tile_prints_the_tileset_and_honours_allowed_shapes(capsys, tmp_path):
+    path = scenario(tmp_path / "square.toml", grid="....\n....\n....\n....")
+    code, out, err = run(capsys, ["tile", path, "--shapes", "O", "--solver", "cpsat"])
+    assert code == 0 and err == ""
+    rows = [line.split() for line in out.splitlines()]
+    assert len(rows) == 4 and all(len(r) == 4 for r in rows)
+    out = run_json(capsys, ["tile", path, "--shapes", "I", "--json"])
+    assert out["shapes"] == {"I": 4}
+
+
+@pytest.mark.parametrize("grid, words", [
+    (".....\n.....", ["10", "multiple of 4"]),
+    ("...#.\n...#.", ["region", "(0, 1)", "6 free cells"]),
+])
+def test_tile_untileable_map_is_one_error_line(capsys, tmp_path, grid, words):
+    path = scenario(tmp_path / "bad.toml", grid=grid)
+    assert_one_error_line(*run(capsys, ["tile", path]), *words)
+
+
+def test_tile_unknown_shape_is_one_error_line(capsys, tmp_path):
+    path = scenario(tmp_path / "square.toml", grid="....\n....")
+    assert_one_error_line(*run(capsys, ["tile", path, "--shapes", "OQ"]), "Q")
+
+
+def test_sequence_a_bundled_paper_tileset_exactly(capsys):
+    out = run_json(capsys, ["sequence", "paper_6x6_fig13a", "--solver", "exact", "--json"])
+    assert set(out) >= {"order", "cost", "runtime_s", "solver", "optimal"}
+    assert sorted(out["order"]) == list(range(1, 10)) and out["order"][0] == 1
+    assert out["optimal"] is True
+    # the reported cost is the eq.-2 cost of the reported order
+    from htetro_opt.problems import SequencingInstance
+    from htetro_opt.scenarios import tileset_path
+
+    inst = SequencingInstance.from_tileset(load_tileset(tileset_path("paper_6x6_fig13a")))
+    assert out["cost"] == pytest.approx(inst.path_cost([inst.ids.index(t) for t in out["order"]]))
+    for solver in ("ortools", "ga", "local"):
+        other = run_json(capsys, ["sequence", "paper_6x6_fig13a", "--solver", solver, "--time-limit", "2", "--json"])
+        if solver == "local":  # a heuristic: no better than the optimum
+            assert other["cost"] >= out["cost"] - 1e-9
+        else:
+            assert other["cost"] == pytest.approx(out["cost"], rel=1e-6), solver
+
+
+@pytest.mark.parametrize("solver", ["zigzag", "zigzag2", "spiral", "spiral2", "greedy", "ga-plain"])
+def test_sequence_baselines_visit_every_tile_once_from_the_start(capsys, solver):
+    out = run_json(capsys, ["sequence", "paper_11x11_fig13d", "--solver", solver, "--start", "5",
+                            "--seed", "3", "--json"])
+    assert out["order"][0] == 5 and sorted(out["order"]) == list(range(1, 29))
+
+
+def test_sequence_a_scenario_tiles_it_first_and_free_start_is_no_worse(capsys, tmp_path):
+    path = scenario(tmp_path / "strip.toml", grid=STRIP)
+    fixed = run_json(capsys, ["sequence", path, "--solver", "exact", "--json"])
+    free = run_json(capsys, ["sequence", path, "--solver", "exact", "--start", "free", "--json"])
+    assert fixed["waypoints"] == free["waypoints"] == 7
+    assert free["cost"] <= fixed["cost"] + 1e-9
+
+
+def test_sequence_same_seed_same_order_and_plot(capsys, tmp_path):
+    argv = ["sequence", "paper_8x7_fig13b", "--solver", "ga-plain", "--seed", "7", "--json"]
+    assert run_json(capsys, argv)["order"] == run_json(capsys, argv)["order"]
+    png = tmp_path / "seq.png"
+    code, out, err = run(capsys, ["sequence", "paper_8x7_fig13b", "--solver", "spiral", "--plot", str(png)])
+    assert code == 0 and png.read_bytes().startswith(PNG_SIGNATURE)
+    assert "cost" in out
+
+
+def test_sequence_weights_change_the_cost(capsys):
+    equal = run_json(capsys, ["sequence", "paper_6x6_fig13a", "--solver", "exact", "--json"])
+    b_only = run_json(capsys, ["sequence", "paper_6x6_fig13a", "--solver", "exact", "--weights", "0,1,0,0", "--json"])
+    assert b_only["weights"] == [0, 1, 0, 0] and b_only["cost"] != pytest.approx(equal["cost"])
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--start", "99"], ["no tile 99"]),
+    (["--start", "first"], ["--start", "free"]),
+    (["--weights", "1,2"], ["weights"]),
+    (["--weights", "a,b,c,d"], ["--weights"]),
+    (["--time-limit", "0"], ["--time-limit"]),
+    (["--shapes", "O"], ["--shapes"]),
+])
+def test_sequence_bad_options_are_one_error_line(capsys, argv, words):
+    assert_one_error_line(*run(capsys, ["sequence", "paper_6x6_fig13a", *argv]), *words)
+
+
+def test_sequence_bad_tileset_files_are_one_error_line(capsys, tmp_path):
+    bad = tmp_path / "bad.txt"
+    bad.write_text("1a 1b 1c 1d\n2a 2b 2c 2x\n")
+    assert_one_error_line(*run(capsys, ["sequence", str(bad)]), "2x", "row 2", "column 4")
+    bad.write_text("1a 1b 1c 1d\n2a 2b 2c .\n")
+    assert_one_error_line(*run(capsys, ["sequence", str(bad)]), "tile 2", "no block d")
+    assert_one_error_line(*run(capsys, ["sequence", str(tmp_path / "none.txt")]), "none.txt")
+
+
+def test_sequence_exact_refuses_large_instances_clearly(capsys, tmp_path):
+    big = scenario(tmp_path / "big.toml", grid="\n".join(["." * 16] * 12))
+    assert_one_error_line(*run(capsys, ["sequence", big, "--solver", "exact"]), "48", "40")

@@ -15,6 +15,14 @@ from htetro_opt.scenarios.loader import (
     parse_scenario,
 )
 from htetro_opt.scenarios.rosmap import load_ros_map, read_pgm
+from htetro_opt.scenarios.tileset import (
+    BLOCK_LETTERS,
+    Tileset,
+    format_tileset,
+    load_tileset,
+    parse_tileset,
+    save_tileset,
+)
 
 __all__ = [
     "Scenario",
@@ -22,12 +30,20 @@ __all__ = [
     "load_scenario",
     "list_scenarios",
     "scenario_path",
+    "list_tilesets",
+    "tileset_path",
     "load_scenario_file",
     "parse_scenario",
     "parse_grid",
     "format_grid",
     "load_ros_map",
     "read_pgm",
+    "Tileset",
+    "BLOCK_LETTERS",
+    "parse_tileset",
+    "format_tileset",
+    "load_tileset",
+    "save_tileset",
 ]
 
 
@@ -69,3 +85,32 @@ def load_scenario(name_or_path: str | Path) -> Scenario | ContinuousScenario:
     (24, 'O')
     """
     return load_scenario_file(scenario_path(name_or_path))
+
+
+def list_tilesets() -> list[str]:
+    """Names of the bundled labelled tilesets (the seed-003 paper's own figures), sorted."""
+    return sorted(p.stem for p in (_data_dir() / "tilesets").glob("*.txt"))
+
+
+def tileset_path(name_or_path: str | Path) -> Path:
+    """Path of a bundled tileset name, or the given path if it names a file.
+
+    Raises
+    ------
+    ScenarioError
+        If it is neither a bundled name nor an existing file.
+
+    Examples
+    --------
+    >>> tileset_path("paper_11x11_fig13d").name
+    'paper_11x11_fig13d.txt'
+    """
+    bundled = _data_dir() / "tilesets" / f"{name_or_path}.txt"
+    if isinstance(name_or_path, str) and "/" not in name_or_path and bundled.is_file():
+        return bundled
+    path = Path(name_or_path)
+    if path.is_file():
+        return path
+    raise ScenarioError(
+        f"no tileset {str(name_or_path)!r}: not a bundled name ({', '.join(list_tilesets())}) nor a file"
+    )

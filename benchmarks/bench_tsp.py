@@ -1,0 +1,143 @@
+"""Quality and speed of seed 003's tiling and waypoint sequencing, every solver side by side.
+
+1. Agreement (≤ 40 waypoints): OR-Tools (its default time limit) against the exact CP-SAT optimum on
+   the paper's six labelled tilesets, our tilings of its four workspaces, and random Euclidean
+   instances of 20, 30 and 40 waypoints, fixed start (tile 1) and free start.
+2. GA: the paper's GA on DEAP (``ga-plain``) and the memetic GA (``ga``, 2-opt/Or-opt on offspring),
+   several seeds each, gap to the exact optimum and time, on the paper-sized instances.
+3. Scale: the 64 × 64 ``tiling_64x64`` map (~1000 waypoints): tiling time by both tilers, then every
+   sequencing solver's cost and time side by side (gap to the best), and the default (``auto``)
+   tile + sequence time against the one-minute target.
+
+Run:  python benchmarks/bench_tsp.py [--quick] [--parts agreement,ga,scale] [--seeds N]
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import statistics
+import time
+
+import numpy as np
+
+from htetro_opt.problems import SequencingInstance, cost_matrix
+from htetro_opt.scenarios import list_tilesets, load_scenario, load_tileset, tileset_path
+from htetro_opt.solvers.sequencing import sequence_waypoints
+from htetro_opt.solvers.tiling import tile_workspace
+
+WORKSPACES = ("tiling_6x6", "tiling_8x7", "tiling_10x10", "tiling_11x11")
+
+
+def _paper_sized() -> list[tuple[str, object]]:
+    out = [(name, load_tileset(tileset_path(name))) for name in list_tilesets()]
+    for name in WORKSPACES:
+        out.append((f"ours {name}", tile_workspace(load_scenario(name).workspace, name=name)))
+    return out
+
+
+def _random_instance(n: int, seed: int, start) -> SequencingInstance:
+    rng = np.random.default_rng(seed)
+    blocks = np.repeat(rng.integers(0, 100, size=(n, 2))[:, None, :], 4, axis=1)
+    return SequencingInstance(cost_matrix(blocks), blocks, start)
+
+
+def agreement(quick: bool) -> None:
+    print("## Agreement: OR-Tools (default time limit) against the exact optimum\n")
+    print("| instance | n | start | exact cost | exact s | proven | OR-Tools cost | OR-Tools s | equal |")
+    print("|---|---:|---|---:|---:|---|---:|---:|---|")
+    cases = [(name, SequencingInstance.from_tileset(ts, start=start), label)
+             for name, ts in _paper_sized() for start, label in ((ts.ids[0], "tile 1"), (None, "free"))]
+    for n in (20, 30, 40):
+        for seed in range(1 if quick else 3):
+            for start, label in ((0, "fixed"), (None, "free")):
+                cases.append((f"random {n} pts, seed {seed}", _random_instance(n, seed, start), label))
+    agree = 0
+    for name, inst, label in cases:
+        exact = sequence_waypoints(inst, "exact")
+        routing = sequence_waypoints(inst, "ortools")
+        same = abs(routing.cost - exact.cost) <= 1e-6 * max(1.0, exact.cost)
+        agree += same
+        print(f"| {name} | {inst.n} | {label} | {exact.cost:.4f} | {exact.runtime_s:.2f} | {exact.info.get('optimal')} | "
+              f"{routing.cost:.4f} | {routing.runtime_s:.2f} | {'yes' if same else 'NO'} |")
+    print(f"\nOR-Tools equals the exact optimum on {agree} of {len(cases)} instances.\n")
+
+
+def ga(quick: bool, seeds: int) -> None:
+    print(f"## GA: plain (the paper's) and memetic, {seeds} seeds, gap to the exact optimum\n")
+    print("| instance | n | optimum | plain gap % mean (max) | plain s | memetic gap % mean (max) | memetic s |")
+    print("|---|---:|---:|---:|---:|---:|---:|")
+    cases = _paper_sized()
+    if quick:
+        cases = cases[-3:]
+    all_gaps = {"ga-plain": [], "ga": []}
+    for name, ts in cases:
+        inst = SequencingInstance.from_tileset(ts, start=ts.ids[0])
+        optimum = sequence_waypoints(inst, "exact").cost
+        cells = []
+        for solver in ("ga-plain", "ga"):
+            runs = [sequence_waypoints(inst, solver, seed=s) for s in range(seeds)]
+            gaps = [100 * (r.cost - optimum) / optimum for r in runs]
+            all_gaps[solver] += gaps
+            cells.append(f"{statistics.mean(gaps):.2f} ({max(gaps):.2f}) | {statistics.mean(r.runtime_s for r in runs):.2f}")
+        print(f"| {name} | {inst.n} | {optimum:.3f} | {cells[0]} | {cells[1]} |")
+    for solver, gaps in all_gaps.items():
+        within = sum(g <= 1.0 for g in gaps)
+        print(f"\n{solver}: within 1 % of the optimum in {within} of {len(gaps)} runs; mean gap {statistics.mean(gaps):.2f} %.")
+    print()
+
+
+def scale(quick: bool) -> None:
+    scenario = load_scenario("tiling_64x64")
+    print("## Scale: tiling_64x64\n")
+    tilings = {}
+    for solver in ("backtracking", "cpsat"):
+        began = time.perf_counter()
+        tilings[solver] = tile_workspace(scenario.workspace, solver=solver, name=scenario.name)
+        print(f"- tiling by {solver}: {len(tilings[solver])} tiles in {time.perf_counter() - began:.2f} s")
+    ts = tilings["backtracking"]
+    inst = SequencingInstance.from_tileset(ts, start=1)
+    print(f"\n{inst.n} waypoints, start tile 1.\n")
+    runs = [("local", {}), ("ortools", {}), ("ortools", {"time_limit": 10.0}),
+            ("ga", {"time_limit": 30.0}), ("ga-plain", {"time_limit": 30.0}),
+            ("greedy", {"iterations": 200 if quick else 1000}),
+            ("zigzag", {}), ("zigzag2", {}), ("spiral", {}), ("spiral2", {})]
+    if not quick:
+        runs.insert(1, ("local", {"time_limit": 10.0, "restarts": 10**6}))
+        runs.insert(4, ("ortools", {"time_limit": 30.0}))
+    results = []
+    for solver, options in runs:
+        r = sequence_waypoints(inst, solver, **options)
+        label = solver + "".join(f", {k}={v:g}" for k, v in options.items())
+        results.append((label, r))
+    best = min(r.cost for _, r in results)
+    print("| solver | cost | gap to best % | time s |")
+    print("|---|---:|---:|---:|")
+    for label, r in sorted(results, key=lambda item: item[1].cost):
+        print(f"| {label} | {r.cost:.2f} | {100 * (r.cost - best) / best:.2f} | {r.runtime_s:.2f} |")
+    began = time.perf_counter()
+    default = sequence_waypoints(SequencingInstance.from_tileset(
+        tile_workspace(scenario.workspace, name=scenario.name), start=1))
+    total = time.perf_counter() - began
+    print(f"\nDefault tile + sequence (backtracking + {default.solver}): {total:.2f} s "
+          f"(target < 60 s), cost {default.cost:.2f}.\n")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--parts", default="agreement,ga,scale")
+    parser.add_argument("--seeds", type=int, default=5)
+    args = parser.parse_args()
+    print(f"# Seed 003 benchmark ({platform.python_version()}, {platform.processor() or platform.machine()})\n")
+    parts = args.parts.split(",")
+    if "agreement" in parts:
+        agreement(args.quick)
+    if "ga" in parts:
+        ga(args.quick, 2 if args.quick else args.seeds)
+    if "scale" in parts:
+        scale(args.quick)
+
+
+if __name__ == "__main__":
+    main()

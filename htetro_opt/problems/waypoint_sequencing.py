@@ -1,0 +1,280 @@
+"""Seed 003's waypoint sequencing: tiles become waypoints, and their order is an open-path TSP.
+
+- **Block locations** (Algorithm 1): tiles are visited in scan order (top row first, left to right);
+  a tile with one filling pose (L, J, T) takes it, a symmetric tile (I, S, Z: 2 options, O: 4) takes
+  the option of least eq.-2 cost to the previous tile's blocks (eq. 3). The first tile, which has no
+  previous one, takes its first option (the lowest heading): a choice of ours.
+- **Cost** (eqs. 1–2): moving from waypoint i to waypoint j costs
+  ``α D_a + β D_b + λ D_c + γ D_d``, ``D_l`` the Euclidean distance between block l's cells at i and
+  at j (in cells). The weights default to 0.25 each.
+- **Sequencing** (eq. 4): the order visiting every waypoint once, from a start tile (tile 1 by
+  default, or free), that minimises the summed cost. The path is open: it does not return.
+
+:class:`SequencingInstance` holds one instance for every solver (cost matrix, block cells, start);
+:class:`SequencingProblem` poses it as a pymoo permutation problem.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from pymoo.core.problem import Problem
+
+from htetro_opt.errors import ParameterError, PlanningError
+from htetro_opt.model.tiles import scan_key, tile_poses
+from htetro_opt.scenarios.tileset import Tileset
+
+__all__ = [
+    "DEFAULT_WEIGHTS",
+    "check_weights",
+    "block_locations",
+    "cost_matrix",
+    "path_cost",
+    "SequencingInstance",
+    "SequencingProblem",
+]
+
+DEFAULT_WEIGHTS = (0.25, 0.25, 0.25, 0.25)
+"""α, β, λ, γ of eq. 2: every block counts the same."""
+
+
+def check_weights(weights) -> np.ndarray:
+    """The eq.-2 weights (α, β, λ, γ) as an array, validated.
+
+    Raises
+    ------
+    ParameterError
+        Unless there are four finite, non-negative weights with a positive sum. (The paper's weights
+        sum to 1; others are accepted as given, not rescaled.)
+
+    Examples
+    --------
+    >>> check_weights([0, 1, 0, 0]).tolist()
+    [0.0, 1.0, 0.0, 0.0]
+    """
+    try:
+        w = np.array(weights, dtype=float).reshape(-1)
+    except (TypeError, ValueError) as err:
+        raise ParameterError(f"weights must be four numbers (α, β, λ, γ), got {weights!r}") from err
+    if w.shape != (4,) or not np.isfinite(w).all() or (w < 0).any() or w.sum() <= 0:
+        raise ParameterError(
+            f"weights must be four finite, non-negative numbers (α, β, λ, γ) with a positive sum, got {w.tolist()}"
+        )
+    return w
+
+
+def cost_matrix(blocks, weights=DEFAULT_WEIGHTS) -> np.ndarray:
+    """Eq. 2 between every pair of waypoints: ``C[i, j] = Σ_l w_l ‖blocks[i, l] − blocks[j, l]‖``.
+
+    Parameters
+    ----------
+    blocks : array_like, shape (n, 4, 2)
+        Cells of blocks a, b, c, d at each waypoint.
+    weights : sequence of 4 float
+        α, β, λ, γ.
+
+    Returns
+    -------
+    ndarray of float, shape (n, n)
+        Symmetric, zero on the diagonal.
+
+    Examples
+    --------
+    >>> blocks = [[(0, 0), (0, 1), (0, 2), (0, 3)], [(3, 0), (3, 1), (3, 2), (3, 3)]]
+    >>> cost_matrix(blocks).tolist()
+    [[0.0, 3.0], [3.0, 0.0]]
+    """
+    w = check_weights(weights)
+    b = np.asarray(blocks, dtype=float).reshape(-1, 4, 2)
+    distance = np.sqrt(((b[:, None] - b[None, :]) ** 2).sum(-1))
+    return distance @ w
+
+
+def path_cost(cost: np.ndarray, order) -> np.ndarray | float:
+    """Summed cost of an open path (one order) or of a batch of orders (rows).
+
+    Examples
+    --------
+    >>> path_cost(np.array([[0, 1, 5], [1, 0, 2], [5, 2, 0]]), [0, 1, 2])
+    3.0
+    """
+    order = np.asarray(order, dtype=np.int64)
+    legs = cost[order[..., :-1], order[..., 1:]].sum(-1)
+    return float(legs) if order.ndim == 1 else legs
+
+
+def block_locations(occupancy, tiles, *, weights=DEFAULT_WEIGHTS, cell_size: float = 1.0, name: str = "") -> Tileset:
+    """Algorithm 1: label the blocks of every tile and number the tiles in scan order.
+
+    Parameters
+    ----------
+    occupancy : ndarray of bool, shape (H, W)
+        The workspace's obstacles.
+    tiles : iterable of array_like, shape (4, 2)
+        The cells of each tile, in any order.
+    weights : sequence of 4 float
+        The eq.-2 weights used to pick among a symmetric tile's options (eq. 3).
+
+    Returns
+    -------
+    Tileset
+        Tiles numbered 1, 2, … in scan order of their first cell, each labelled by a robot footprint.
+
+    Raises
+    ------
+    ConfigurationError
+        If a tile's cells are not a tetromino.
+
+    Examples
+    --------
+    >>> ts = block_locations(np.zeros((2, 4), bool), [[(0, 0), (1, 0), (2, 0), (3, 0)], [(0, 1), (1, 1), (2, 1), (3, 1)]])
+    >>> [p.heading for p in ts.poses]  # the second I takes the option whose blocks lie beside the first's
+    [1, 1]
+    """
+    w = check_weights(weights)
+    ordered = sorted((np.asarray(t, dtype=np.int64).reshape(4, 2) for t in tiles),
+                     key=lambda cells: scan_key(min(map(tuple, cells.tolist()), key=scan_key)))
+    poses = []
+    previous = None
+    for cells in ordered:
+        options = tile_poses(cells)
+        if previous is None or len(options) == 1:
+            chosen = options[0]
+        else:
+            footprints = np.array([p.cells() for p in options], dtype=float)
+            costs = np.sqrt(((footprints - previous) ** 2).sum(-1)) @ w
+            chosen = options[int(np.argmin(costs))]
+        poses.append(chosen)
+        previous = chosen.cells().astype(float)
+    return Tileset.from_poses(occupancy, poses, cell_size=cell_size, name=name)
+
+
+@dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
+class SequencingInstance:
+    """One waypoint-sequencing instance, shared by every solver.
+
+    Parameters
+    ----------
+    cost : ndarray of float, shape (n, n)
+        Eq.-2 cost between waypoints (symmetric, zero diagonal).
+    blocks : ndarray of int, shape (n, 4, 2)
+        Cells of blocks a–d at each waypoint (the pattern baselines scan block b's cell).
+    start : int or None
+        Index (0…n−1) of the waypoint every path starts from, or None for a free start.
+    ids : tuple of int
+        Tile labels, for reporting orders.
+    shape : (int, int)
+        The grid's (H, W).
+    """
+
+    cost: np.ndarray
+    blocks: np.ndarray
+    start: int | None = 0
+    ids: tuple[int, ...] = ()
+    shape: tuple[int, int] = (0, 0)
+
+    def __post_init__(self) -> None:
+        cost = np.array(self.cost, dtype=float)
+        n = len(cost)
+        if cost.shape != (n, n) or n == 0 or not np.isfinite(cost).all():
+            raise PlanningError(f"the cost matrix must be square, non-empty and finite, got shape {cost.shape}")
+        if self.start is not None and not 0 <= self.start < n:
+            raise PlanningError(f"start waypoint index {self.start} is outside 0…{n - 1}")
+        blocks = np.array(self.blocks, dtype=np.int64).reshape(n, 4, 2)
+        ids = tuple(self.ids) or tuple(range(1, n + 1))
+        for array in (cost, blocks):
+            array.setflags(write=False)
+        object.__setattr__(self, "cost", cost)
+        object.__setattr__(self, "blocks", blocks)
+        object.__setattr__(self, "ids", ids)
+
+    @classmethod
+    def from_tileset(cls, tileset: Tileset, *, start: int | None = 1, weights=DEFAULT_WEIGHTS) -> "SequencingInstance":
+        """The instance of a labelled tileset.
+
+        Parameters
+        ----------
+        start : int or None
+            The label of the start tile (tile 1 by default), or None for a free start.
+
+        Raises
+        ------
+        TilesetFormatError
+            If no tile has the start label.
+        PlanningError
+            If the tileset has no tiles.
+
+        Examples
+        --------
+        >>> from htetro_opt.scenarios import parse_tileset
+        >>> inst = SequencingInstance.from_tileset(parse_tileset("1a 1b 1c 1d\\n2a 2b 2c 2d"))
+        >>> inst.cost.tolist(), inst.start
+        ([[0.0, 1.0], [1.0, 0.0]], 0)
+        """
+        if len(tileset) == 0:
+            raise PlanningError(f"{tileset.name or 'tileset'} has no tiles to sequence")
+        index = None if start is None else tileset.index(start)
+        return cls(cost_matrix(tileset.blocks, weights), tileset.blocks, index, tileset.ids,
+                   tileset.occupancy.shape)
+
+    @property
+    def n(self) -> int:
+        return len(self.cost)
+
+    def path_cost(self, order) -> float:
+        """Summed cost of an order (waypoint indices)."""
+        return path_cost(self.cost, order)
+
+    def check_order(self, order) -> np.ndarray:
+        """The order as an int array, checked to visit every waypoint once from the start.
+
+        Raises
+        ------
+        PlanningError
+            If it is not a permutation of 0…n−1 or does not begin at the start waypoint.
+        """
+        order = np.asarray(order, dtype=np.int64).reshape(-1)
+        if len(order) != self.n or not np.array_equal(np.sort(order), np.arange(self.n)):
+            raise PlanningError(f"an order must visit each of the {self.n} waypoints exactly once")
+        if self.start is not None and order[0] != self.start:
+            raise PlanningError(f"an order must begin at tile {self.ids[self.start]}, not tile {self.ids[order[0]]}")
+        return order
+
+    def tile_order(self, order) -> list[int]:
+        """Tile labels of an order of waypoint indices."""
+        return [self.ids[i] for i in np.asarray(order, dtype=np.int64).tolist()]
+
+
+class SequencingProblem(Problem):
+    """The sequencing instance as a pymoo permutation problem, so pymoo's GAs can run on it.
+
+    With a fixed start the variables are a permutation of the other ``n − 1`` waypoints (use pymoo's
+    ``PermutationRandomSampling``, ``OrderCrossover``, ``InversionMutation``); :meth:`order` turns a
+    solution into the full order. One objective, the path cost.
+
+    Examples
+    --------
+    >>> from htetro_opt.scenarios import parse_tileset
+    >>> inst = SequencingInstance.from_tileset(parse_tileset("1a 1b 1c 1d\\n2a 2b 2c 2d\\n3a 3b 3c 3d"))
+    >>> problem = SequencingProblem(inst)
+    >>> problem.n_var, problem.evaluate(np.array([[0, 1], [1, 0]]))[:, 0].tolist()
+    (2, [2.0, 3.0])
+    """
+
+    def __init__(self, instance: SequencingInstance):
+        self.instance = instance
+        self._free = np.array([i for i in range(instance.n) if i != instance.start], dtype=np.int64)
+        super().__init__(n_var=len(self._free), n_obj=1, xl=0, xu=max(len(self._free) - 1, 0), vtype=int)
+
+    def order(self, x) -> np.ndarray:
+        """Full waypoint order(s) of solution(s) ``x``."""
+        x = np.asarray(x, dtype=np.int64)
+        rest = self._free[x]
+        if self.instance.start is None:
+            return rest
+        head = np.full(rest.shape[:-1] + (1,), self.instance.start, dtype=np.int64)
+        return np.concatenate([head, rest], axis=-1)
+
+    def _evaluate(self, x, out, *args, **kwargs):
+        out["F"] = np.atleast_1d(path_cost(self.instance.cost, self.order(x))).reshape(-1, 1)

@@ -1,0 +1,128 @@
+"""Seed 003's waypoints (Algorithm 1), eq.-2 cost and the sequencing instance / pymoo problem."""
+
+import itertools
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from htetro_opt.errors import ParameterError, PlanningError, TilesetFormatError
+from htetro_opt.model.robot import Pose
+from htetro_opt.model.tiles import tile_poses
+from htetro_opt.problems import (
+    SequencingInstance,
+    SequencingProblem,
+    block_locations,
+    check_weights,
+    cost_matrix,
+    path_cost,
+)
+from htetro_opt.scenarios import Tileset, parse_tileset
+
+points = st.lists(st.tuples(st.integers(0, 9), st.integers(0, 9)), min_size=2, max_size=6)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.lists(st.tuples(st.integers(0, 9), st.integers(0, 9)), min_size=4, max_size=4), min_size=2, max_size=5),
+       st.lists(st.floats(0, 1), min_size=4, max_size=4).filter(lambda w: sum(w) > 0))
+def test_cost_is_the_weighted_sum_of_block_displacements(blocks, weights):
+    cost = cost_matrix(blocks, weights)
+    b = np.array(blocks, float)
+    for i, j in itertools.product(range(len(b)), repeat=2):
+        expected = sum(w * np.hypot(*(b[i, l] - b[j, l])) for l, w in enumerate(weights))
+        assert cost[i, j] == pytest.approx(expected)
+    assert np.allclose(cost, cost.T) and np.allclose(np.diag(cost), 0)
+
+
+def test_path_cost_sums_consecutive_legs_for_one_order_and_for_a_batch():
+    cost = np.array([[0, 1, 5], [1, 0, 2], [5, 2, 0]], float)
+    assert path_cost(cost, [2, 1, 0]) == 3.0
+    assert path_cost(cost, [[0, 2, 1], [1, 0, 2]]).tolist() == [7.0, 6.0]
+
+
+@pytest.mark.parametrize("weights", [[0.25] * 3, [-1, 1, 0, 0], [0, 0, 0, 0], [np.nan, 1, 0, 0], "abc"])
+def test_bad_weights_are_parameter_errors(weights):
+    with pytest.raises(ParameterError, match="weights"):
+        check_weights(weights)
+
+
+def test_algorithm1_numbers_tiles_in_scan_order_and_labels_them_by_footprints():
+    # a 4 x 2 strip: two O tiles, listed in reverse order
+    tiles = [[(2, 0), (3, 0), (2, 1), (3, 1)], [(0, 0), (1, 0), (0, 1), (1, 1)]]
+    ts = block_locations(np.zeros((2, 4), bool), tiles)
+    assert ts.ids == (1, 2)
+    assert ts.blocks[0, :, 0].max() == 1  # tile 1 is the left square
+    assert all(p is not None for p in ts.poses)
+
+
+def test_algorithm1_picks_the_option_nearest_the_previous_waypoint():
+    # an L (one option) then, right of it, an O (four options): the O takes the option of least eq.-2
+    # cost to the L's blocks (eq. 3)
+    l_cells = Pose(0, 0, "L", 0).cells()  # (1,0) (0,0) (0,1) (0,2): first in scan order at (0, 2)
+    o_cells = [(2, 1), (3, 1), (2, 2), (3, 2)]  # first in scan order at (2, 2): tile 2
+    ts = block_locations(np.zeros((3, 4), bool), [o_cells, l_cells])
+    assert ts.shapes == ("L", "O")
+    options = np.array([p.cells() for p in tile_poses(o_cells)], float)
+    costs = np.sqrt(((options - ts.blocks[0]) ** 2).sum(-1)).mean(-1)
+    assert len(set(np.round(costs, 9))) > 1  # the choice matters here
+    assert np.array_equal(ts.blocks[1], options[np.argmin(costs)])
+
+
+def test_algorithm1_follows_the_previous_tile_in_scan_order_through_a_chain_of_symmetric_tiles():
+    # three horizontal I tiles stacked: each one should copy its predecessor's heading (all blocks move 1 cell)
+    tiles = [[(x, y) for x in range(4)] for y in range(3)]
+    ts = block_locations(np.zeros((3, 4), bool), tiles)
+    assert len({p.heading for p in ts.poses}) == 1
+    inst = SequencingInstance.from_tileset(ts)
+    assert inst.path_cost([0, 1, 2]) == pytest.approx(2.0)
+
+
+def test_instance_from_tileset_knows_its_start_and_checks_orders():
+    ts = parse_tileset("1a 1b 1c 1d\n2a 2b 2c 2d\n3a 3b 3c 3d")
+    inst = SequencingInstance.from_tileset(ts, start=2)
+    assert inst.start == 1 and inst.n == 3 and inst.ids == (1, 2, 3)
+    assert inst.check_order([1, 0, 2]).tolist() == [1, 0, 2]
+    assert inst.tile_order([1, 0, 2]) == [2, 1, 3]
+    with pytest.raises(PlanningError, match="begin at tile 2"):
+        inst.check_order([0, 1, 2])
+    with pytest.raises(PlanningError, match="exactly once"):
+        inst.check_order([1, 1, 2])
+    with pytest.raises(TilesetFormatError, match="no tile 7"):
+        SequencingInstance.from_tileset(ts, start=7)
+    assert SequencingInstance.from_tileset(ts, start=None).start is None
+    with pytest.raises(PlanningError, match="no tiles"):
+        SequencingInstance.from_tileset(Tileset(np.zeros((2, 2), bool), np.empty((0, 4, 2)), ()))
+
+
+def test_pymoo_problem_evaluates_path_costs_from_the_fixed_start():
+    rng = np.random.default_rng(1)
+    pts = rng.integers(0, 20, size=(6, 2))
+    blocks = np.repeat(pts[:, None, :], 4, axis=1)
+    inst = SequencingInstance(cost_matrix(blocks), blocks, start=3)
+    problem = SequencingProblem(inst)
+    assert problem.n_var == 5
+    perms = np.array([rng.permutation(5) for _ in range(8)])
+    orders = problem.order(perms)
+    assert (orders[:, 0] == 3).all()
+    assert np.allclose(problem.evaluate(perms)[:, 0], [inst.path_cost(o) for o in orders])
+
+
+def test_pymoo_ga_runs_on_the_problem_and_its_best_order_is_valid():
+    from pymoo.algorithms.soo.nonconvex.ga import GA
+    from pymoo.operators.crossover.ox import OrderCrossover
+    from pymoo.operators.mutation.inversion import InversionMutation
+    from pymoo.operators.sampling.rnd import PermutationRandomSampling
+    from pymoo.optimize import minimize
+
+    rng = np.random.default_rng(3)
+    blocks = np.repeat(rng.integers(0, 10, size=(7, 2))[:, None, :], 4, axis=1)
+    inst = SequencingInstance(cost_matrix(blocks), blocks, start=0)
+    problem = SequencingProblem(inst)
+    algorithm = GA(pop_size=20, sampling=PermutationRandomSampling(), crossover=OrderCrossover(),
+                   mutation=InversionMutation(), eliminate_duplicates=True)
+    res = minimize(problem, algorithm, ("n_gen", 40), seed=1)
+    order = inst.check_order(problem.order(res.X))
+    brute = min(inst.path_cost((0,) + p) for p in itertools.permutations(range(1, 7)))
+    assert res.F[0] == pytest.approx(inst.path_cost(order))
+    assert inst.path_cost(order) >= brute - 1e-9

@@ -1,0 +1,366 @@
+"""Tetromino tiling (seed 003 §3.1): exact covers checked cell by cell, against an independent naive
+search, on the paper's workspaces, and the overlapping sub-workspace option of its Fig. 5."""
+
+import re
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from htetro_opt.errors import ParameterError, TilingError, UnknownShapeError
+from htetro_opt.model import Workspace
+from htetro_opt.model.tiles import PATTERNS, identify_tile, scan_key
+from htetro_opt.scenarios import load_scenario
+from htetro_opt.solvers.tiling import TILING_SOLVERS, enumerate_tilings, find_tiles, tile_workspace
+
+SOLVERS = list(TILING_SOLVERS)
+PAPER = ["tiling_6x6", "tiling_8x7", "tiling_10x10", "tiling_11x11"]
+
+
+def grid(text):
+    """Occupancy from text rows, top row first ('#' obstacle), as the scenario files write maps."""
+    rows = [line.strip() for line in text.strip().splitlines()]
+    return np.array([[c == "#" for c in row] for row in rows[::-1]], dtype=bool)
+
+
+def assert_exact_cover(occ, tiles, shapes=None):
+    """Every free cell covered exactly once, no obstacle or outside cell, every tile an allowed tetromino."""
+    h, w = occ.shape
+    count = np.zeros(occ.shape, dtype=int)
+    for cells in tiles:
+        cells = np.asarray(cells)
+        assert cells.shape == (4, 2)
+        assert ((cells[:, 0] >= 0) & (cells[:, 0] < w) & (cells[:, 1] >= 0) & (cells[:, 1] < h)).all()
+        pattern = identify_tile(cells)
+        assert pattern is not None, f"{cells.tolist()} is not a tetromino"
+        if shapes is not None:
+            assert pattern.shape in shapes
+        count[cells[:, 1], cells[:, 0]] += 1
+    assert (count[occ] == 0).all(), "a tile covers an obstacle"
+    assert (count[~occ] == 1).all(), "a free cell is uncovered or covered twice"
+
+
+def tiling_key(tiles):
+    return frozenset(tuple(sorted(map(tuple, np.asarray(t).tolist()))) for t in tiles)
+
+
+def naive_tileable(occ, shapes=None):
+    """Independent oracle: plain recursive exact cover over sets, no pruning at all."""
+    offsets = [[tuple(c) for c in p.cells.tolist()] for p in PATTERNS if shapes is None or p.shape in shapes]
+    h, w = occ.shape
+
+    def search(free):
+        if not free:
+            return True
+        x, y = min(free, key=scan_key)
+        for cells in offsets:
+            tile = {(x + dx, y + dy) for dx, dy in cells}
+            if tile <= free and search(free - tile):
+                return True
+        return False
+
+    return search(frozenset((x, y) for y in range(h) for x in range(w) if not occ[y, x]))
+
+
+# ------------------------------------------------------------------------------------------------
+# Exact covers
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+@pytest.mark.parametrize("name", PAPER)
+def test_paper_workspaces_tile(name, solver):
+    occ = load_scenario(name).workspace.occupancy
+    tiles = find_tiles(occ, solver=solver)
+    assert_exact_cover(occ, tiles)
+    assert len(tiles) == (~occ).sum() // 4
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_10x10_with_z_and_t_only(solver):
+    """Fig. 12c: the paper tiles its 10 x 10 workspace with Z and T alone."""
+    occ = load_scenario("tiling_10x10").workspace.occupancy
+    tiles = find_tiles(occ, shapes="TZ", solver=solver)
+    assert_exact_cover(occ, tiles, shapes="TZ")
+    assert len(tiles) == 25
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_o_only(solver):
+    """Fig. 16c: O alone tiles the 6 x 6 workspace; the 8 x 7 one has an odd height and cannot be."""
+    occ = load_scenario("tiling_6x6").workspace.occupancy
+    tiles = find_tiles(occ, shapes=["O"], solver=solver)
+    assert_exact_cover(occ, tiles, shapes="O")
+    assert len(tiles) == 9
+    with pytest.raises(TilingError):
+        find_tiles(load_scenario("tiling_8x7").workspace.occupancy, shapes="O", solver=solver)
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_tiles_come_in_scan_order(solver):
+    occ = load_scenario("tiling_11x11").workspace.occupancy
+    firsts = [min(map(tuple, t.tolist()), key=scan_key) for t in find_tiles(occ, solver=solver)]
+    assert firsts == sorted(firsts, key=scan_key)
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    data=st.data(),
+    w=st.integers(1, 6),
+    h=st.integers(1, 6),
+    shapes=st.sampled_from([None, "TZ", "O", "IO", "LJ", "SZ", "T", "LJT", "IT"]),
+)
+def test_small_grids_agree_with_naive_search(data, w, h, shapes):
+    """Both solvers find a tiling exactly when an unpruned search does, and what they find is one."""
+    occ = np.array(data.draw(st.lists(st.booleans(), min_size=w * h, max_size=w * h)), dtype=bool).reshape(h, w)
+    if (~occ).sum() % 4:  # mostly, let the area fit so the search itself is exercised
+        ys, xs = np.nonzero(~occ)
+        k = int((~occ).sum() % 4)
+        occ[ys[:k], xs[:k]] = True
+    truth = (~occ).any() and naive_tileable(occ, shapes)
+    for solver in SOLVERS:
+        try:
+            tiles = find_tiles(occ, shapes=shapes, solver=solver)
+        except TilingError:
+            assert not truth, f"{solver} missed a tiling"
+        else:
+            assert truth
+            assert_exact_cover(occ, tiles, shapes)
+
+
+def test_medium_cluttered_grids_solvers_agree():
+    """Scattered obstacles (the region checks, the memo and the sub-searches all at work)."""
+    rng = np.random.default_rng(7)
+    for _ in range(6):
+        h, w = rng.integers(8, 15, 2)
+        occ = np.zeros((h, w), dtype=bool)
+        for _ in range(4):
+            x, y = rng.integers(0, w - 1), rng.integers(0, h - 1)
+            occ[y:y + rng.integers(1, 3), x:x + rng.integers(1, 3)] = True
+        ys, xs = np.nonzero(~occ)
+        occ[ys[: (~occ).sum() % 4], xs[: (~occ).sum() % 4]] = True
+        outcomes = []
+        for solver in SOLVERS:
+            try:
+                tiles = find_tiles(occ, solver=solver, time_limit=20)
+            except TilingError as err:
+                assert "time limit" not in str(err)
+                outcomes.append(False)
+            else:
+                assert_exact_cover(occ, tiles)
+                outcomes.append(True)
+        assert outcomes[0] == outcomes[1]
+
+
+def test_64x64_with_obstacle_blocks_is_fast():
+    occ = np.zeros((64, 64), dtype=bool)
+    for x, y, s in [(10, 10, 4), (30, 40, 4), (50, 20, 2), (20, 51, 2), (41, 7, 4)]:
+        occ[y:y + s, x:x + s] = True
+    tiles = find_tiles(occ, solver="backtracking", time_limit=10)
+    assert_exact_cover(occ, tiles)
+    assert len(tiles) == (~occ).sum() // 4
+
+
+# ------------------------------------------------------------------------------------------------
+# Pre-checks: each names what is wrong and where
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_no_free_cell(solver):
+    with pytest.raises(TilingError, match="no free cell"):
+        find_tiles(np.ones((3, 3), dtype=bool), solver=solver)
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_area_not_a_multiple_of_4(solver):
+    with pytest.raises(TilingError, match=r"free area is 42 cells, not a multiple of 4"):
+        find_tiles(np.zeros((7, 6), dtype=bool), solver=solver)
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_isolated_cell_is_located(solver):
+    occ = grid("""
+        #.##
+        ####
+        ....
+        ....
+        ###.
+        ##..
+    """)  # 12 free cells: an isolated one at (1, 5) and a region of 11
+    with pytest.raises(TilingError, match=re.escape("the region around cell (1, 5) has 1 free cell")) as info:
+        find_tiles(occ, solver=solver)
+    assert "isolated" in str(info.value)
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_region_of_wrong_size_is_located(solver):
+    occ = grid("""
+        .....#..
+        .....#..
+        ######..
+    """)  # 16 free cells: regions of 10 and 6
+    with pytest.raises(TilingError, match=re.escape("the region around cell (0, 2) has 10 free cells")):
+        find_tiles(occ, solver=solver)
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_checkerboard_parity_without_t(solver):
+    occ = grid("""
+        ###
+        ...
+        #.#
+    """)  # a T-shaped region: 1 black ((x + y) even) and 3 white cells
+    with pytest.raises(TilingError, match=r"1 black and 3 white cells of a checkerboard") as info:
+        find_tiles(occ, shapes="IOLJZS", solver=solver)
+    assert "without T" in str(info.value)
+    assert_exact_cover(occ, find_tiles(occ, solver=solver))  # with T it tiles
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_colourings_of_tiling_theory(solver):
+    """10 x 10 by L and J, or by T alone, fails a colouring (Walkup: both need an area divisible by 8)."""
+    with pytest.raises(TilingError, match=r"50 cells in even columns.*odd"):
+        find_tiles(np.zeros((10, 10), dtype=bool), shapes="LJ", solver=solver)
+    with pytest.raises(TilingError, match=r"50 black and 50 white.*T tiles"):
+        find_tiles(np.zeros((10, 10), dtype=bool), shapes="T", solver=solver)
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_untileable_map_passing_every_precheck(solver):
+    with pytest.raises(TilingError, match=r"no tiling of the 36 free cells by ZT tetrominoes exists"):
+        find_tiles(np.zeros((6, 6), dtype=bool), shapes="TZ", solver=solver)
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_time_limit_is_reported(solver):
+    with pytest.raises(TilingError, match="time limit") as info:
+        find_tiles(np.zeros((16, 16), dtype=bool), solver=solver, time_limit=1e-9)
+    if solver == "backtracking":
+        assert "cpsat" in str(info.value)
+
+
+def test_invalid_options():
+    occ = np.zeros((4, 4), dtype=bool)
+    with pytest.raises(UnknownShapeError):
+        find_tiles(occ, shapes="TQ")
+    for empty in ("", []):
+        with pytest.raises(ParameterError, match="shapes"):
+            find_tiles(occ, shapes=empty)
+    with pytest.raises(ParameterError, match="solver"):
+        find_tiles(occ, solver="dlx")
+    with pytest.raises(ParameterError, match="time_limit"):
+        find_tiles(occ, time_limit=-1)
+    with pytest.raises(ParameterError, match="seed"):
+        find_tiles(occ, seed=1.5)
+    with pytest.raises(ParameterError, match="2-D"):
+        find_tiles(np.zeros((2, 2, 2), dtype=bool))
+    with pytest.raises(ParameterError, match="limit"):
+        enumerate_tilings(occ, limit=0)
+    with pytest.raises(ParameterError, match="weights"):
+        tile_workspace(occ, weights=(1, 2))
+
+
+# ------------------------------------------------------------------------------------------------
+# Seeds and enumeration
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_seeds(solver):
+    occ = load_scenario("tiling_10x10").workspace.occupancy
+    first = tiling_key(find_tiles(occ, solver=solver, seed=3))
+    assert tiling_key(find_tiles(occ, solver=solver, seed=3)) == first
+    assert tiling_key(find_tiles(occ, solver=solver)) == tiling_key(find_tiles(occ, solver=solver))
+    others = {tiling_key(find_tiles(occ, solver=solver, seed=s)) for s in range(4)}
+    assert len(others) > 1
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_enumerate_all_117_tilings_of_the_4x4_square(solver):
+    """The 4 x 4 square has 117 tetromino tilings; asking for more returns exactly those."""
+    occ = np.zeros((4, 4), dtype=bool)
+    tilesets = enumerate_tilings(occ, limit=500, solver=solver)
+    keys = {tiling_key(ts.blocks) for ts in tilesets}
+    assert len(tilesets) == len(keys) == 117
+    for ts in tilesets:
+        assert_exact_cover(occ, ts.blocks)
+        assert ts.ids == tuple(range(1, len(ts) + 1))
+    first = enumerate_tilings(occ, limit=5, solver=solver)
+    assert [tiling_key(t.blocks) for t in first] == [tiling_key(t.blocks) for t in tilesets[:5]]
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_enumerate_is_deterministic_and_limited(solver):
+    occ = load_scenario("tiling_8x7").workspace.occupancy
+    a = enumerate_tilings(occ, shapes="TZ", limit=6, solver=solver)
+    b = enumerate_tilings(occ, shapes="TZ", limit=6, solver=solver)
+    assert len(a) == 6
+    assert [tiling_key(t.blocks) for t in a] == [tiling_key(t.blocks) for t in b]
+    assert len({tiling_key(t.blocks) for t in a}) == 6
+    for ts in a:
+        assert_exact_cover(occ, ts.blocks, shapes="TZ")
+    assert len(enumerate_tilings(np.zeros((6, 6), dtype=bool), shapes="O", limit=4, solver=solver)) == 1
+
+
+# ------------------------------------------------------------------------------------------------
+# Overlapping sub-workspaces (Fig. 5d-f) and the labelled tileset
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_overlap_6x7(solver):
+    occ = np.zeros((7, 6), dtype=bool)  # 6 wide, 7 high: 42 cells
+    with pytest.raises(TilingError, match="42"):
+        tile_workspace(occ, solver=solver)
+    ts = tile_workspace(occ, solver=solver, overlap=True)
+    coverage = ts.coverage()
+    assert ts.complete and ts.overlapping
+    assert (coverage >= 1).all() and coverage.sum() == 48 and len(ts) == 12
+    assert (coverage == 2).sum() == 6
+    assert (coverage[1] == 2).all()  # the fewest shared cells: rows y < 2 and y >= 1 share row 1
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_overlap_7x6_splits_columns(solver):
+    ts = tile_workspace(np.zeros((6, 7), dtype=bool), solver=solver, overlap=True)
+    coverage = ts.coverage()
+    assert ts.complete and coverage.sum() == 48
+    assert (coverage[:, 1] == 2).all() and (coverage == 2).sum() == 6  # rows would share 14 cells
+
+
+def test_overlap_keeps_a_tileable_map_as_it_is():
+    occ = load_scenario("tiling_11x11").workspace.occupancy
+    plain, overlapping = tile_workspace(occ), tile_workspace(occ, overlap=True)
+    assert not overlapping.overlapping
+    assert tiling_key(plain.blocks) == tiling_key(overlapping.blocks)
+
+
+def test_overlap_fails_when_no_split_tiles():
+    occ = grid("""
+        .#...
+        ##...
+        ##...
+        ##..#
+    """)  # 12 free cells; (0, 3) is isolated in every band that holds it
+    with pytest.raises(TilingError, match=r"\(0, 3\) has 1 free cell.*overlapping bands"):
+        tile_workspace(occ, overlap=True)
+
+
+@pytest.mark.parametrize("name", PAPER)
+def test_tile_workspace_labels(name):
+    ws = load_scenario(name).workspace
+    ts = tile_workspace(ws, name=name)
+    assert ts.name == name and ts.cell_size == ws.cell_size
+    assert ts.complete and not ts.overlapping
+    assert ts.ids == tuple(range(1, len(ts) + 1))
+    firsts = [min(map(tuple, cells.tolist()), key=scan_key) for cells in ts.blocks]
+    assert firsts == sorted(firsts, key=scan_key)
+    assert None not in ts.poses
+    for pose, cells in zip(ts.poses, ts.blocks):
+        assert np.array_equal(pose.cells(), cells)  # blocks a-d are B1-B4 of a robot footprint
+
+
+def test_tile_workspace_accepts_a_workspace_or_an_array():
+    occ = load_scenario("tiling_6x6").workspace.occupancy
+    a = tile_workspace(Workspace(occ, cell_size=0.5), shapes="O")
+    b = tile_workspace(occ, shapes="O")
+    assert a.cell_size == 0.5 and b.cell_size == 1.0
+    assert np.array_equal(a.blocks, b.blocks)
