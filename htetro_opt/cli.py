@@ -47,6 +47,7 @@ __all__ = ["main", "main_entry", "build_parser"]
 
 EXIT_ERROR = 2
 PLAN_METHODS = {"exact": "dijkstra", "astar": "astar", "nsga2": "ga"}
+TILING_TIME_LIMIT = 60.0  # the backtracker can search long on cluttered maps with few allowed shapes
 
 
 class _Parser(argparse.ArgumentParser):
@@ -114,7 +115,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--overlap", action="store_true",
                    help="if the map cannot be tiled, cover it by two overlapping sub-workspaces (seed 003 Fig. 5)")
     p.add_argument("--seed", type=int, help="shuffle the placement order, for another tiling")
-    p.add_argument("--time-limit", type=float, help="give up after this many seconds")
+    p.add_argument("--time-limit", type=float, default=TILING_TIME_LIMIT,
+                   help=f"give up after this many seconds (default {TILING_TIME_LIMIT:g})")
     p.add_argument("--out", metavar="FILE", help="write the labelled tileset to FILE")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plot", metavar="FILE", help="save a PNG of the tileset")
@@ -372,7 +374,8 @@ def _cmd_sequence(args) -> dict:
             raise ParameterError(f"--start must be a tile label or 'free', got {args.start!r}") from err
     if _is_scenario(args.tileset):
         scenario_path(args.tileset)  # a clear error for a missing file
-        tileset = _tileset_of_scenario(args.tileset, shapes=list(args.shapes) if args.shapes else None)
+        tileset = _tileset_of_scenario(args.tileset, shapes=list(args.shapes) if args.shapes else None,
+                                       time_limit=TILING_TIME_LIMIT)
     else:
         if args.shapes:
             raise ParameterError("--shapes applies only when TILESET is a scenario to tile")

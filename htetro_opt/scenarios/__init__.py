@@ -56,6 +56,16 @@ def list_scenarios() -> list[str]:
     return sorted(p.stem for p in _data_dir().glob("*.toml"))
 
 
+def _bundled_or_file(name_or_path: str | Path, folder: Path, suffix: str, kind: str, names) -> Path:
+    bundled = folder / f"{name_or_path}{suffix}"
+    if isinstance(name_or_path, str) and "/" not in name_or_path and bundled.is_file():
+        return bundled
+    path = Path(name_or_path)
+    if path.is_file():
+        return path
+    raise ScenarioError(f"no {kind} {str(name_or_path)!r}: not a bundled name ({', '.join(names())}) nor a file")
+
+
 def scenario_path(name_or_path: str | Path) -> Path:
     """Path of a bundled scenario name, or the given path if it names a file.
 
@@ -64,15 +74,7 @@ def scenario_path(name_or_path: str | Path) -> Path:
     ScenarioError
         If it is neither a bundled name nor an existing file.
     """
-    bundled = _data_dir() / f"{name_or_path}.toml"
-    if isinstance(name_or_path, str) and "/" not in name_or_path and bundled.is_file():
-        return bundled
-    path = Path(name_or_path)
-    if path.is_file():
-        return path
-    raise ScenarioError(
-        f"no scenario {str(name_or_path)!r}: not a bundled name ({', '.join(list_scenarios())}) nor a file"
-    )
+    return _bundled_or_file(name_or_path, _data_dir(), ".toml", "scenario", list_scenarios)
 
 
 def load_scenario(name_or_path: str | Path) -> Scenario | ContinuousScenario:
@@ -105,12 +107,4 @@ def tileset_path(name_or_path: str | Path) -> Path:
     >>> tileset_path("paper_11x11_fig13d").name
     'paper_11x11_fig13d.txt'
     """
-    bundled = _data_dir() / "tilesets" / f"{name_or_path}.txt"
-    if isinstance(name_or_path, str) and "/" not in name_or_path and bundled.is_file():
-        return bundled
-    path = Path(name_or_path)
-    if path.is_file():
-        return path
-    raise ScenarioError(
-        f"no tileset {str(name_or_path)!r}: not a bundled name ({', '.join(list_tilesets())}) nor a file"
-    )
+    return _bundled_or_file(name_or_path, _data_dir() / "tilesets", ".txt", "tileset", list_tilesets)

@@ -100,9 +100,10 @@ def sequence_waypoints(instance: SequencingInstance, solver: str = "auto", *, se
     Examples
     --------
     >>> from htetro_opt.scenarios import parse_tileset
-    >>> inst = SequencingInstance.from_tileset(parse_tileset("1a 1b 1c 1d\\n2a 2b 2c 2d\\n3a 3b 3c 3d"), start=2)
-    >>> sequence_waypoints(inst, "exact").tiles
-    [2, 1, 3]
+    >>> inst = SequencingInstance.from_tileset(parse_tileset("1a 1b 1c 1d\\n2a 2b 2c 2d\\n3a 3b 3c 3d"), start=3)
+    >>> result = sequence_waypoints(inst, "exact")
+    >>> result.tiles, result.cost
+    ([3, 2, 1], 2.0)
     """
     if time_limit is not None and not time_limit > 0:
         raise ParameterError(f"time limit must be positive, got {time_limit!r}")

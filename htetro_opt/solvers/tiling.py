@@ -91,17 +91,21 @@ from scipy import ndimage
 from htetro_opt.errors import ParameterError, TilingError
 from htetro_opt.model.tiles import Pattern, patterns_of
 from htetro_opt.model.workspace import Workspace
-from htetro_opt.problems.waypoint_sequencing import DEFAULT_WEIGHTS, block_locations, check_weights
+from htetro_opt.problems.waypoint_sequencing import (
+    DEFAULT_WEIGHTS,
+    block_locations,
+    check_weights,
+)
 from htetro_opt.scenarios.tileset import Tileset
 
 __all__ = [
-    "TILING_SOLVERS",
     "EXACT_LIMIT",
     "FLOOD_LIMIT",
     "MEMO_LIMIT",
+    "TILING_SOLVERS",
+    "enumerate_tilings",
     "find_tiles",
     "tile_workspace",
-    "enumerate_tilings",
 ]
 
 TILING_SOLVERS = ("backtracking", "cpsat")
@@ -135,7 +139,9 @@ def _as_occupancy(workspace) -> tuple[np.ndarray, float]:
     try:
         occ = np.asarray(workspace)
     except (TypeError, ValueError) as err:
-        raise ParameterError(f"the workspace must be a Workspace or an (H, W) bool array, got {type(workspace).__name__}") from err
+        raise ParameterError(
+            f"the workspace must be a Workspace or an (H, W) bool array, got {type(workspace).__name__}"
+        ) from err
     if occ.ndim != 2 or 0 in occ.shape:
         raise ParameterError(f"the occupancy must be a non-empty 2-D (H, W) array, got shape {occ.shape}")
     if occ.dtype != bool:
@@ -147,13 +153,10 @@ def _as_occupancy(workspace) -> tuple[np.ndarray, float]:
 
 def _check_shapes(shapes) -> tuple[Pattern, ...]:
     if shapes is not None:
-        if isinstance(shapes, str):
-            names = list(shapes)
-        else:
-            try:
-                names = list(shapes)
-            except TypeError as err:
-                raise ParameterError(f"shapes must be morphology names such as 'TZ' or ['O'], got {shapes!r}") from err
+        try:
+            names = list(shapes)  # "TZ" -> ["T", "Z"]
+        except TypeError as err:
+            raise ParameterError(f"shapes must be morphology names such as 'TZ' or ['O'], got {shapes!r}") from err
         if not names:
             raise ParameterError("shapes is empty: allow at least one morphology (I, O, L, J, Z, S, T)")
         shapes = names
@@ -167,7 +170,8 @@ def _check_options(solver, seed, time_limit) -> float | None:
         raise ParameterError(f"seed must be a non-negative integer or None, got {seed!r}")
     if time_limit is None:
         return None
-    if isinstance(time_limit, bool) or not isinstance(time_limit, numbers.Real) or not math.isfinite(time_limit) or time_limit <= 0:
+    if (isinstance(time_limit, bool) or not isinstance(time_limit, numbers.Real)
+            or not math.isfinite(time_limit) or time_limit <= 0):
         raise ParameterError(f"time_limit must be a positive number of seconds or None, got {time_limit!r}")
     return _time.perf_counter() + float(time_limit)
 
@@ -230,7 +234,7 @@ def _colour_rules(patterns) -> tuple:
 _PERIOD = 4  # cells are counted by (x mod 4, y mod 4): 16 classes
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _class_lattice(shapes: str) -> tuple:
     """An echelon basis (over the integers) of the class counts that tilings by these shapes can have.
 
@@ -345,11 +349,11 @@ def _violation(occ: np.ndarray, patterns) -> str | None:
     return None
 
 
-def _precheck(occ: np.ndarray, patterns, *, where: str = "") -> None:
+def _precheck(occ: np.ndarray, patterns) -> None:
     """The necessary conditions every solver checks first; TilingError naming the first that fails."""
     problem = _violation(occ, patterns)
     if problem is not None:
-        raise TilingError(f"{where}: {problem}" if where else problem)
+        raise TilingError(problem)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -449,7 +453,7 @@ def _backtrack(occ: np.ndarray, patterns, order, deadline, cache: dict):
     # Everything before the anchor is covered and no tile reaches 3 rows past its anchor, so the
     # anchor and the cells [anchor, anchor + window) are the whole search state: a state whose
     # subtree held no tiling is remembered (as a 128-bit digest) and never searched again.
-    window = 1 * stride + 1
+    window = 3 * stride + 1
     failed: set[bytes] = set()
 
     def state(at: int) -> bytes:
@@ -615,9 +619,9 @@ def _time_message(solver, time_limit) -> str:
     return f"CP-SAT found no tiling within the time limit of {time_limit:g} s; try a longer time limit"
 
 
-def _tilings(occ, patterns, solver, seed, deadline, limit, *, where=""):
+def _tilings(occ, patterns, solver, seed, deadline, limit):
     """Pre-checks, then up to ``limit`` tilings (non-empty list) or TilingError / _TimeLimit."""
-    _precheck(occ, patterns, where=where)
+    _precheck(occ, patterns)
     if solver == "backtracking":
         found = []
         generator = _backtracking_tilings(occ, patterns, seed, deadline)
@@ -634,9 +638,8 @@ def _tilings(occ, patterns, solver, seed, deadline, limit, *, where=""):
     else:
         found = _cpsat_tilings(occ, patterns, seed, deadline, limit)
     if not found:
-        prefix = f"{where}: " if where else ""
         raise TilingError(
-            f"{prefix}no tiling of the {int((~occ).sum())} free cells by {_shape_text(patterns)} tetrominoes exists "
+            f"no tiling of the {int((~occ).sum())} free cells by {_shape_text(patterns)} tetrominoes exists "
             f"(the {solver} search is exhaustive)"
         )
     return found
@@ -729,7 +732,9 @@ def _band(occ: np.ndarray, axis: int, lo: int, hi: int) -> np.ndarray:
 
 def _overlapping_tiles(occ, patterns, solver, seed, deadline, cause):
     """The tiles of the best split whose two bands both tile (see :func:`tile_workspace`)."""
-    for shared, axis, k1, k2 in _band_splits(occ):
+    for _shared, axis, k1, k2 in _band_splits(occ):
+        if deadline is not None and _time.perf_counter() > deadline:
+            raise _TimeLimit("time limit")
         n = occ.shape[axis]
         band_a, band_b = _band(occ, axis, 0, k2), _band(occ, axis, k1, n)
         if _violation(band_a, patterns) is not None or _violation(band_b, patterns) is not None:

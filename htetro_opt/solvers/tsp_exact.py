@@ -29,12 +29,12 @@ from htetro_opt.errors import ParameterError, PlanningError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, path_cost
 
 __all__ = [
+    "COST_RESOLUTION",
     "EXACT_MAX_SIZE",
     "EXACT_TIME_LIMIT",
-    "COST_RESOLUTION",
     "HELD_KARP_MAX_SIZE",
-    "solve_exact",
     "held_karp",
+    "solve_exact",
 ]
 
 EXACT_MAX_SIZE = 40

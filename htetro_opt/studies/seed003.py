@@ -38,7 +38,7 @@ import numpy as np
 
 from htetro_opt._files import atomic_path
 from htetro_opt.errors import HtetroError, ParameterError, TilingError
-from htetro_opt.problems.waypoint_sequencing import DEFAULT_WEIGHTS, SequencingInstance, path_cost
+from htetro_opt.problems.waypoint_sequencing import SequencingInstance, path_cost
 from htetro_opt.scenarios import Tileset, load_scenario, load_tileset, tileset_path
 from htetro_opt.solvers.sequencing import sequence_waypoints
 from htetro_opt.solvers.tiling import tile_workspace
@@ -209,7 +209,6 @@ def run_table45(tileset: Tileset, table1: Iterable[dict]) -> list[dict]:
     of any cell under any of them is 255. (Each method scaled to its own maximum, the better paths
     look worse, since their hottest cell is cooler; the paper does not say which scale it used.)
     """
-    instance = SequencingInstance.from_tileset(tileset, start=tileset.ids[0])
     runs, seen = [], set()
     for row in table1:
         if row["tileset"] != tileset.name or row["method"] in seen:
