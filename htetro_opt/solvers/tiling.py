@@ -296,7 +296,7 @@ def _violation(occ: np.ndarray, patterns) -> str | None:
         return "the workspace has no free cell to tile"
     if n_free % 4:
         return (f"the free area is {n_free} cells, not a multiple of 4: no tetromino tiling covers it "
-                "exactly (tile_workspace's overlap=True can split it into two overlapping sub-workspaces)")
+                "exactly (the overlap option, --overlap on the command line, covers it by two overlapping sub-workspaces)")
     labels, n = ndimage.label(free)  # 4-connected
     ys, xs = np.nonzero(free)
     scan = np.lexsort((xs, -ys))
