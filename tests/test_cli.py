@@ -578,3 +578,12 @@ def test_sequence_bad_tileset_files_are_one_error_line(capsys, tmp_path):
 def test_sequence_exact_refuses_large_instances_clearly(capsys, tmp_path):
     big = scenario(tmp_path / "big.toml", grid="\n".join(["." * 16] * 12))
     assert_one_error_line(*run(capsys, ["sequence", big, "--solver", "exact"]), "48", "40")
+
+
+def test_console_script_output_into_a_closed_pipe_is_no_traceback():
+    exe = Path(sys.executable).parent / "htetro-opt"
+    proc = subprocess.Popen([str(exe), "scenarios"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # the reader goes away before the first line is written, as `| head -0` would
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=60) == 1
+    assert "Traceback" not in err and "BrokenPipeError" not in err
