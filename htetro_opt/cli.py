@@ -17,6 +17,7 @@ from typing import Sequence
 import numpy as np
 
 from htetro_opt import __version__
+from htetro_opt._argparse import Parser, UsageError
 from htetro_opt.errors import HtetroError, ParameterError, PlanningError, ScenarioError
 from htetro_opt.model import Simulator, parse_commands
 from htetro_opt.model.commands import DIAGONAL_COMMANDS, SEED000_COMMANDS
@@ -51,19 +52,10 @@ PLAN_METHODS = {"exact": "dijkstra", "astar": "astar", "nsga2": "ga"}
 TILING_TIME_LIMIT = 60.0  # the backtracker can search long on cluttered maps with few allowed shapes
 
 
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str):  # one line, exit 2 (argparse prints usage too)
-        raise _UsageError(message)
-
-
-class _UsageError(Exception):
-    """A command-line usage error, reported like every other error: one line, exit status 2."""
-
-
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="htetro-opt", description="Path planning for the hTetro reconfigurable robot.")
+    parser = Parser(prog="htetro-opt", description="Path planning for the hTetro reconfigurable robot.")
     parser.add_argument("--version", action="version", version=f"htetro-opt {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
 
     p = sub.add_parser("scenarios", help="list the bundled scenarios")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -407,7 +399,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         args = parser.parse_args(argv)
         out = _COMMANDS[args.command](args)
-    except (_UsageError, HtetroError) as err:
+    except (UsageError, HtetroError) as err:
         print("error: " + " ".join(str(err).split()), file=sys.stderr)
         return EXIT_ERROR
     except SystemExit as done:  # --help and --version

@@ -80,7 +80,9 @@ def patterns_of(shapes=None) -> tuple[Pattern, ...]:
     Raises
     ------
     UnknownShapeError
-        If a name is not one of the seven morphologies.
+        If a name is not a state of the robot.
+    ConfigurationError
+        If a name is one of seed 004's intermediate states, which tile nothing.
 
     Examples
     --------

@@ -329,8 +329,9 @@ class _Search:
         """Restricted rounds of each move in turn until none improves, then (``certify``) one full
         round of each; back to restricted rounds if a full one still improved."""
         while True:
-            while self._each(round_fns, q, self._rounds, full=False):
-                pass
+            improved = True
+            while improved:
+                improved = self._each(round_fns, q, self._rounds, full=False)
             if not certify or not self._each(round_fns, q, self._round, full=True):
                 return q
 

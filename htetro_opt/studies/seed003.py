@@ -27,7 +27,6 @@ which prints the markdown tables and, with ``--out``, writes ``DIR/seed003.md`` 
 
 from __future__ import annotations
 
-import argparse
 import csv
 import io
 import sys
@@ -36,6 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
+from htetro_opt._argparse import Parser, UsageError
 from htetro_opt._files import atomic_path
 from htetro_opt.errors import HtetroError, ParameterError, TilingError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, path_cost
@@ -316,18 +316,9 @@ def write_csv(records: Iterable[dict], path) -> Path:
     return Path(path)
 
 
-class _UsageError(Exception):
-    pass
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str):
-        raise _UsageError(message)
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the study from the command line; returns the exit status (0 success, 2 error)."""
-    parser = _Parser(prog="python -m htetro_opt.studies.seed003", description=__doc__.split("\n\n")[0])
+    parser = Parser(prog="python -m htetro_opt.studies.seed003", description=__doc__.split("\n\n")[0])
     parser.add_argument("--seeds", type=int, default=5, help="seeds of the stochastic methods (default 5)")
     parser.add_argument("--time-limit", type=float, help="cap in seconds for each solver that takes one")
     parser.add_argument("--out", help="directory for seed003.md and seed003.csv")
@@ -346,7 +337,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             write_csv(records, out / "seed003.csv")
             with atomic_path(out / "seed003.md") as tmp:
                 tmp.write_text(report + "\n", encoding="utf-8")
-    except (_UsageError, HtetroError, OSError) as err:
+    except (UsageError, HtetroError, OSError) as err:
         print("error: " + " ".join(str(err).split()), file=sys.stderr)
         return 2
     except SystemExit as done:

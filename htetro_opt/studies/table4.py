@@ -38,6 +38,7 @@ from typing import Any
 
 import numpy as np
 
+from htetro_opt._argparse import Parser, UsageError
 from htetro_opt._files import atomic_path
 from htetro_opt.errors import ConfigurationError, HtetroError, ParameterError
 from htetro_opt.model.commands import SEED000_COMMANDS
@@ -689,13 +690,6 @@ def read_csv(path: str | os.PathLike) -> list[dict]:
 
 
 # --- command line --------------------------------------------------------------------------------
-class _UsageError(Exception):
-    """A command-line usage error: one line, exit status 2."""
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str):
-        raise _UsageError(message)
 
 
 def _int_list(text: str) -> list[int]:
@@ -713,7 +707,7 @@ def _name_list(text: str) -> list[str]:
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="python -m htetro_opt.studies.table4",
+    p = Parser(prog="python -m htetro_opt.studies.table4",
                 description="Re-run seed 000's Table 4 (hTetro-GA) and compare every plan with the exact optimum.")
     p.add_argument("--envs", type=_name_list, default=list(ENVIRONMENTS),
                    help=f"comma-separated environments (default all: {','.join(ENVIRONMENTS)})")
@@ -759,7 +753,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if out is not None:
             write_csv(records, out / "table4.csv")
             _write_atomic(out / "table4.md", table)
-    except (_UsageError, HtetroError, OSError) as err:
+    except (UsageError, HtetroError, OSError) as err:
         print("error: " + " ".join(str(err).split()), file=sys.stderr)
         return 2
     except SystemExit as done:  # --help
