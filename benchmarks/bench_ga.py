@@ -1,4 +1,4 @@
-"""Speed and quality of seed 000's GA (hTetro-GA), with pymoo's NSGA-II on the same operators beside it.
+"""Speed and quality of Cheng et al. 2020's GA (hTetro-GA), with pymoo's NSGA-II on the same operators beside it.
 
 1. Per-generation time: ``minimize(problem, HTetroGA(pop_size=n), ("n_gen", 200), seed=s)`` on the
    24 x 24 maps three_slit and random, n_pop = 50 and 100, beside ``HTetroGA.as_published(n)`` (the
@@ -10,15 +10,15 @@
    evaluated-individuals column says how many.
 2. Per-generation split of the same runs, measured by wrapping each part's entry point: the problem's
    ``_evaluate`` (the batch simulation and the four fitnesses), the repair (it simulates every new
-   chromosome too; with hTetro-GA's fused repair-and-shortcut step, the shortcut too), the other
+   chromosome too; with hTetro-GA's one ``repair_and_shortcut`` call per generation, the shortcut too), the other
    operators (sampling, tournament selection, crossover, mutation, removal, rearrangement, shortcut), duplicate elimination, survival (the non-dominated sort), and the
    rest (pymoo's population bookkeeping, chromosome trimming, the evaluator and termination).
 3. Quality: ``plan_ga`` (n_pop = 50) a few seeds per environment of Table 4, with the reach rate,
    the generations, the best time in the final leading front against the exact minimum-time plan, and
-   the gap (via :func:`htetro_opt.studies.table4.run_trial`), for each algorithm of ``--algorithms``.
+   the gap (via :func:`htetro_opt.studies.table4.run_trial`), for each method of ``--methods``.
 
 Run:  python benchmarks/bench_ga.py [--quick] [--parts timing,split,quality] [--repeat N] [--jobs N]
-                                    [--algorithms htetro,htetro-paper]
+                                    [--methods htetro-ga,htetro-ga-paper]
 
 --quick: 1 seed per timing cell, and quality with 2 seeds and max_gen 300 (full: 3 timing seeds,
 10 quality seeds, max_gen 1000).
@@ -39,12 +39,11 @@ import pymoo
 from pymoo.core.callback import Callback
 from pymoo.optimize import minimize
 
-from htetro_opt.model import Simulator
-from htetro_opt.model.commands import SEED000_COMMANDS
+from htetro_opt.algorithms import HTetroGA, make_algorithm
+from htetro_opt.algorithms import htetro_ga as htetro_ga_module
+from htetro_opt.model import SEED000_COMMANDS, Simulator
 from htetro_opt.problems import CommandPathProblem
 from htetro_opt.scenarios import load_scenario
-from htetro_opt.solvers import HTetroGA, make_algorithm
-from htetro_opt.solvers import htetro_ga as htetro_ga_module
 from htetro_opt.studies.metrics import format_mean_std
 from htetro_opt.studies.table4 import ENVIRONMENTS, run_study, summarise
 
@@ -52,7 +51,7 @@ TIMING_MAPS = ("three_slit", "random")
 POP_SIZES = (50, 100)
 N_GEN = 200
 TARGET_MS = 20.0  # the issue's target per generation at n_pop = 100
-TIMED = ("htetro", "htetro-paper", "nsga2")
+TIMED = ("htetro-ga", "htetro-ga-paper", "nsga2")
 PARTS = ("evaluation", "repair", "operators", "duplicates", "survival", "other")
 
 
@@ -69,14 +68,6 @@ def _problem(name: str) -> CommandPathProblem:
     scenario = load_scenario(name)
     sim = Simulator(scenario.workspace, commands=SEED000_COMMANDS)
     return CommandPathProblem(sim, scenario.start, scenario.goal, max_length=100)
-
-
-def _algorithm(kind: str, n: int):
-    if kind == "htetro":
-        return HTetroGA(pop_size=n)
-    if kind == "htetro-paper":
-        return HTetroGA.as_published(n)
-    return make_algorithm(kind, n)
 
 
 class _Clock:
@@ -129,13 +120,13 @@ class _Clock:
 def run_once(name: str, kind: str, n: int, seed: int, *, split: bool) -> dict:
     """One ``minimize`` run of N_GEN generations; with ``split`` the parts are timed too.
 
-    The parts are found by name: each operator's ``do`` and ``_do`` (hTetro-GA calls some ``_do``
-    directly on the design matrix), the survival's ``do``, the duplicate elimination's ``do`` and the
-    ``first_occurrences`` helper of :mod:`htetro_opt.solvers.htetro_ga` and HTetroGA's fused
-    ``_repair_and_shortcut`` (counted as repair) where they exist.
+    The parts are found by name: each operator's ``do`` (every algorithm, hTetro-GA included, calls
+    its operators through it), the survival's ``do``, the duplicate elimination's ``do``, and in
+    :mod:`htetro_opt.algorithms.htetro_ga` the ``first_occurrences`` helper and the
+    ``repair_and_shortcut`` function that HTetroGA calls once per generation (counted as repair).
     """
     problem = _problem(name)
-    algorithm = _algorithm(kind, n)
+    algorithm = make_algorithm(kind, n)
     clock = _Clock()
     clock.count_evaluations(problem)  # cheap: a few calls per generation
     if split:
@@ -143,14 +134,11 @@ def run_once(name: str, kind: str, n: int, seed: int, *, split: bool) -> dict:
         mating = algorithm.mating
         operators = [algorithm.initialization.sampling, mating.selection, mating.crossover, mating.mutation]
         if isinstance(algorithm, HTetroGA):
-            operators += [algorithm.removal, algorithm.rearrangement, getattr(algorithm, "shortcut", None)]
+            operators += [algorithm.removal, algorithm.rearrangement]
         for op in operators:
-            if op is not None:
-                clock.wrap(op, "do", "operators")
-                clock.wrap(op, "_do", "operators")
-        for attr in ("do", "_do"):
-            clock.wrap(algorithm.repair, attr, "repair")  # shared with mating/initialisation
-        clock.wrap(algorithm, "_repair_and_shortcut", "repair")  # HTetroGA's fused repair + shortcut
+            clock.wrap(op, "do", "operators")
+        clock.wrap(algorithm.repair, "do", "repair")  # shared with mating/initialisation
+        clock.wrap(htetro_ga_module, "repair_and_shortcut", "repair")  # HTetroGA's one repair + shortcut step
         clock.wrap(algorithm.eliminate_duplicates, "do", "duplicates")
         clock.wrap(htetro_ga_module, "first_occurrences", "duplicates")
         clock.wrap(algorithm.survival, "do", "survival")
@@ -208,8 +196,8 @@ def print_timing(rows: list[dict]) -> None:
                 print(f"| {name} | {n} | {kind} | {r['ms_per_gen']:.1f} | {r['cpu_ms_per_gen']:.1f} "
                       f"| {r['evaluated_per_gen']:.0f} | {1e3 * r['cpu_ms_per_gen'] / r['evaluated_per_gen']:.0f} "
                       f"| {r['cpu_ms_per_gen'] / base:.2f}× |")
-    worst = max(by[(m, "htetro", 100)]["ms_per_gen"] for m in TIMING_MAPS)
-    worst_cpu = max(by[(m, "htetro", 100)]["cpu_ms_per_gen"] for m in TIMING_MAPS)
+    worst = max(by[(m, "htetro-ga", 100)]["ms_per_gen"] for m in TIMING_MAPS)
+    worst_cpu = max(by[(m, "htetro-ga", 100)]["cpu_ms_per_gen"] for m in TIMING_MAPS)
     print(f"\nTarget < {TARGET_MS:g} ms per generation of HTetroGA at n_pop = 100: "
           f"{'met' if worst < TARGET_MS else 'NOT met'} on wall time (worst {worst:.1f} ms), "
           f"{'met' if worst_cpu < TARGET_MS else 'NOT met'} on CPU time (worst {worst_cpu:.1f} ms).\n")
@@ -227,22 +215,22 @@ def print_split(rows: list[dict]) -> None:
     print()
 
 
-def quality(seeds: int, max_gen: int, jobs: int, algorithms: list[str]) -> list[dict]:
+def quality(seeds: int, max_gen: int, jobs: int, methods: list[str]) -> list[dict]:
     def report(done, total, record):
-        print(f"  [{done}/{total}] {record['algorithm']} {record['environment']} seed {record['seed']}: "
+        print(f"  [{done}/{total}] {record['method']} {record['environment']} seed {record['seed']}: "
               f"{'reached' if record['reached'] else 'not reached'}, {record['terminate_time_s']:.1f} s",
               file=sys.stderr, flush=True)
 
     records = []
-    for algorithm in algorithms:
-        records += run_study(ENVIRONMENTS, [50], range(seeds), max_gen=max_gen, algorithm=algorithm,
+    for method in methods:
+        records += run_study(ENVIRONMENTS, [50], range(seeds), max_gen=max_gen, method=method,
                              jobs=jobs, progress=report)
     return records
 
 
 def print_quality(records: list[dict], seeds: int, max_gen: int) -> None:
     print(f"## Quality: plan_ga, n_pop = 50, {seeds} seeds per environment, max_gen {max_gen}, patience 100\n")
-    print("| environment | algorithm | reached | reach gen | terminate gen | run time (s) | exact optimum "
+    print("| environment | method | reached | reach gen | terminate gen | run time (s) | exact optimum "
           "| best GA time | gap mean | gap max | output plan time |")
     print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
 
@@ -252,7 +240,7 @@ def print_quality(records: list[dict], seeds: int, max_gen: int) -> None:
     for row in summarise(records):
         lo, hi = row["exact_time_min"], row["exact_time_max"]
         exact = "–" if lo is None else (f"{lo:g}" if lo == hi else f"{lo:g}–{hi:g}")
-        print(f"| {row['environment']} | {row['algorithm']} | {row['reached']}/{row['runs']} "
+        print(f"| {row['environment']} | {row['method']} | {row['reached']}/{row['runs']} "
               f"| {format_mean_std(row['reach_generation_mean'], row['reach_generation_std'], digits=1)} "
               f"| {format_mean_std(row['terminate_generation_mean'], row['terminate_generation_std'], digits=1)} "
               f"| {format_mean_std(row['terminate_time_s_mean'], row['terminate_time_s_std'], digits=1)} "
@@ -268,8 +256,8 @@ def main() -> None:
     parser.add_argument("--parts", default="timing,split,quality", help="comma-separated: timing, split, quality")
     parser.add_argument("--repeat", type=int, help="seeds per timing cell (default 3, quick 1)")
     parser.add_argument("--jobs", type=int, default=1, help="processes for the quality runs (default 1)")
-    parser.add_argument("--algorithms", default="htetro,htetro-paper",
-                        help="comma-separated algorithms for the quality runs (default htetro,htetro-paper)")
+    parser.add_argument("--methods", default="htetro-ga,htetro-ga-paper",
+                        help="comma-separated methods for the quality runs (default htetro-ga,htetro-ga-paper)")
     args = parser.parse_args()
     parts = {p.strip() for p in args.parts.split(",") if p.strip()}
     unknown = parts - {"timing", "split", "quality"}
@@ -284,8 +272,8 @@ def main() -> None:
         print_split(timing(repeat, split=True))
     if "quality" in parts:
         seeds, max_gen = (2, 300) if args.quick else (10, 1000)
-        algorithms = [a.strip() for a in args.algorithms.split(",") if a.strip()]
-        print_quality(quality(seeds, max_gen, args.jobs, algorithms), seeds, max_gen)
+        methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+        print_quality(quality(seeds, max_gen, args.jobs, methods), seeds, max_gen)
 
 
 if __name__ == "__main__":

@@ -11,7 +11,7 @@
    and heapq A* against networkx's Dijkstra over the same graph, including every method's graph build
    (the simulator's table compile is timed apart: every method needs it).
 
-Run:  python benchmarks/bench_model.py [--repeat N] [--markdown]
+Run:  python benchmarks/bench_model.py [--repeat N]
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ import numpy as np
 
 from htetro_opt.model import Simulator
 from htetro_opt.scenarios import load_scenario
-from htetro_opt.solvers import plan_exact
+from htetro_opt.solvers.grid_paths import plan_exact
 
 
 def timed(fn, repeat):
@@ -170,7 +170,7 @@ def bench_exact(name: str, repeat: int) -> dict:
     t_compile, sim = timed(lambda: Simulator(scenario.workspace.without_moving()), repeat)
     start_id, goal_id = sim.check_pose(roadmap[0]), sim.encode(roadmap[1])
     t_dij, plan = timed(lambda: plan_exact(sim, roadmap), repeat)
-    t_astar, plan_a = timed(lambda: plan_exact(sim, roadmap, algorithm="astar"), repeat)
+    t_astar, plan_a = timed(lambda: plan_exact(sim, roadmap, method="astar"), repeat)
     t_nx, nx_time = timed(lambda: networkx_leg(sim, start_id, goal_id), max(1, repeat // 2))
     assert abs(plan.time - plan_a.time) < 1e-9 and abs(plan.time - nx_time) < 1e-9
     return {
@@ -191,7 +191,7 @@ def bench_moving(name: str, repeat: int) -> dict:
     scenario = load_scenario(name)
     t_compile, sim = timed(lambda: Simulator(scenario.workspace), repeat)
     t_dij, plan = timed(lambda: plan_exact(sim, scenario.roadmap), repeat)
-    t_astar, plan_a = timed(lambda: plan_exact(sim, scenario.roadmap, algorithm="astar"), repeat)
+    t_astar, plan_a = timed(lambda: plan_exact(sim, scenario.roadmap, method="astar"), repeat)
     assert plan.reached and abs(plan.time - plan_a.time) < 1e-9
     return {"scenario": name, "period": scenario.workspace.period, "legs": len(scenario.roadmap) - 1,
             "nodes": sim.n_poses * scenario.workspace.period, "optimum_time": plan.time,
@@ -203,7 +203,7 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=7)
     args = parser.parse_args()
     rows, compile_s = bench_simulator(args.repeat)
-    print("## Simulator: 100 sequences x 100 commands, 24 x 24 map ('random'), seed 000 commands\n")
+    print("## Simulator: 100 sequences x 100 commands, 24 x 24 map ('random'), Cheng et al. 2020's commands\n")
     print("| population | executed | `Simulator.run` | loop over swept cells | loop, compiled numpy table "
           "| loop, compiled list table |")
     print("|---|---:|---:|---:|---:|---:|")

@@ -1,13 +1,13 @@
-"""Quality and speed of seed 003's tiling and waypoint sequencing, every solver side by side.
+"""Quality and speed of the tiling and waypoint sequencing of Le et al. 2018, every method side by side.
 
 1. Agreement (≤ 40 waypoints): OR-Tools (its default time limit, 1 s up to 20 waypoints rising to 30 s at 40) against the exact CP-SAT optimum on
    the paper's six labelled tilesets, our tilings of its four workspaces, and random Euclidean
    instances of 20, 30 and 40 waypoints, fixed start (tile 1) and free start.
 2. GA: the paper's GA on DEAP (``ga-plain``) and the memetic GA (``ga``, 2-opt/Or-opt on offspring),
    several seeds each, gap to the exact optimum and time, on the paper-sized instances.
-3. Scale: the 64 × 64 ``tiling_64x64`` map (~1000 waypoints): tiling time by both tilers, then every
-   sequencing solver's cost and time side by side (gap to the best), and the default (``auto``)
-   tile + sequence time against the one-minute target.
+3. Scale: the 64 × 64 ``tiling_64x64`` map (~1000 waypoints): tiling time by both tiling methods,
+   then every sequencing method's cost and time side by side (gap to the best), and the default
+   (``auto``) tile + sequence time against the one-minute target.
 
 Run:  python benchmarks/bench_tsp.py [--quick] [--parts agreement,ga,scale] [--seeds N]
 """
@@ -24,7 +24,7 @@ import numpy as np
 from htetro_opt.problems import SequencingInstance, cost_matrix
 from htetro_opt.scenarios import list_tilesets, load_scenario, load_tileset, tileset_path
 from htetro_opt.solvers.sequencing import sequence_waypoints
-from htetro_opt.solvers.tiling import tile_workspace
+from htetro_opt.solvers.tiling import TILING_METHODS, tile_workspace
 
 WORKSPACES = ("tiling_6x6", "tiling_8x7", "tiling_10x10", "tiling_11x11")
 
@@ -54,8 +54,8 @@ def agreement(quick: bool) -> None:
                 cases.append((f"random {n} pts, seed {seed}", _random_instance(n, seed, start), label))
     agree = 0
     for name, inst, label in cases:
-        exact = sequence_waypoints(inst, "exact")
-        routing = sequence_waypoints(inst, "ortools")
+        exact = sequence_waypoints(inst, method="exact")
+        routing = sequence_waypoints(inst, method="ortools")
         same = abs(routing.cost - exact.cost) <= 1e-6 * max(1.0, exact.cost)
         agree += same
         print(f"| {name} | {inst.n} | {label} | {exact.cost:.4f} | {exact.runtime_s:.2f} | {exact.info.get('optimal')} | "
@@ -73,17 +73,17 @@ def ga(quick: bool, seeds: int) -> None:
     all_gaps = {"ga-plain": [], "ga": []}
     for name, ts in cases:
         inst = SequencingInstance.from_tileset(ts, start=ts.ids[0])
-        optimum = sequence_waypoints(inst, "exact").cost
+        optimum = sequence_waypoints(inst, method="exact").cost
         cells = []
-        for solver in ("ga-plain", "ga"):
-            runs = [sequence_waypoints(inst, solver, seed=s) for s in range(seeds)]
+        for method in ("ga-plain", "ga"):
+            runs = [sequence_waypoints(inst, method=method, seed=s) for s in range(seeds)]
             gaps = [100 * (r.cost - optimum) / optimum for r in runs]
-            all_gaps[solver] += gaps
+            all_gaps[method] += gaps
             cells.append(f"{statistics.mean(gaps):.2f} ({max(gaps):.2f}) | {statistics.mean(r.runtime_s for r in runs):.2f}")
         print(f"| {name} | {inst.n} | {optimum:.3f} | {cells[0]} | {cells[1]} |")
-    for solver, gaps in all_gaps.items():
+    for method, gaps in all_gaps.items():
         within = sum(g <= 1.0 for g in gaps)
-        print(f"\n{solver}: within 1 % of the optimum in {within} of {len(gaps)} runs; mean gap {statistics.mean(gaps):.2f} %.")
+        print(f"\n{method}: within 1 % of the optimum in {within} of {len(gaps)} runs; mean gap {statistics.mean(gaps):.2f} %.")
     print()
 
 
@@ -91,10 +91,10 @@ def scale(quick: bool) -> None:
     scenario = load_scenario("tiling_64x64")
     print("## Scale: tiling_64x64\n")
     tilings = {}
-    for solver in ("backtracking", "cpsat"):
+    for method in TILING_METHODS:
         began = time.perf_counter()
-        tilings[solver] = tile_workspace(scenario.workspace, solver=solver, name=scenario.name)
-        print(f"- tiling by {solver}: {len(tilings[solver])} tiles in {time.perf_counter() - began:.2f} s")
+        tilings[method] = tile_workspace(scenario.workspace, method=method, name=scenario.name)
+        print(f"- tiling by {method}: {len(tilings[method])} tiles in {time.perf_counter() - began:.2f} s")
     ts = tilings["backtracking"]
     inst = SequencingInstance.from_tileset(ts, start=1)
     print(f"\n{inst.n} waypoints, start tile 1.\n")
@@ -105,12 +105,12 @@ def scale(quick: bool) -> None:
     if not quick:
         runs.insert(1, ("local", {"time_limit": 10.0, "restarts": 10**6}))
     results = []
-    for solver, options in runs:
-        r = sequence_waypoints(inst, solver, **options)
-        label = solver + "".join(f", {k}={v:g}" for k, v in options.items())
+    for method, options in runs:
+        r = sequence_waypoints(inst, method=method, **options)
+        label = method + "".join(f", {k}={v:g}" for k, v in options.items())
         results.append((label, r))
     best = min(r.cost for _, r in results)
-    print("| solver | cost | gap to best % | time s |")
+    print("| method | cost | gap to best % | time s |")
     print("|---|---:|---:|---:|")
     for label, r in sorted(results, key=lambda item: item[1].cost):
         print(f"| {label} | {r.cost:.2f} | {100 * (r.cost - best) / best:.2f} | {r.runtime_s:.2f} |")
@@ -118,7 +118,7 @@ def scale(quick: bool) -> None:
     default = sequence_waypoints(SequencingInstance.from_tileset(
         tile_workspace(scenario.workspace, name=scenario.name), start=1))
     total = time.perf_counter() - began
-    print(f"\nDefault tile + sequence (backtracking + {default.solver}): {total:.2f} s "
+    print(f"\nDefault tile + sequence (backtracking + {default.method}): {total:.2f} s "
           f"(target < 60 s), cost {default.cost:.2f}.\n")
 
 
@@ -128,7 +128,7 @@ def main() -> None:
     parser.add_argument("--parts", default="agreement,ga,scale")
     parser.add_argument("--seeds", type=int, default=5)
     args = parser.parse_args()
-    print(f"# Seed 003 benchmark ({platform.python_version()}, {platform.processor() or platform.machine()})\n")
+    print(f"# Le et al. 2018 benchmark ({platform.python_version()}, {platform.processor() or platform.machine()})\n")
     parts = args.parts.split(",")
     if "agreement" in parts:
         agreement(args.quick)

@@ -4,6 +4,7 @@ from htetro_opt.errors import (
     ConfigurationError,
     HtetroError,
     MapFormatError,
+    OutputError,
     ParameterError,
     PlanningError,
     ScenarioError,
@@ -27,4 +28,5 @@ __all__ = [
     "ParameterError",
     "TilesetFormatError",
     "TilingError",
+    "OutputError",
 ]

@@ -10,20 +10,24 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import signal
 import sys
 import time
+from pathlib import Path
 from typing import Sequence
 
 import numpy as np
 
 from htetro_opt import __version__
 from htetro_opt._argparse import Parser, UsageError
+from htetro_opt._files import check_output_path, write_text
+from htetro_opt._validation import check_int, check_real, check_seed, check_time_limit
+from htetro_opt.algorithms import GA_ALGORITHMS
 from htetro_opt.errors import HtetroError, ParameterError, PlanningError, ScenarioError
 from htetro_opt.model import Simulator, parse_commands
 from htetro_opt.model.commands import DIAGONAL_COMMANDS, SEED000_COMMANDS
 from htetro_opt.model.robot import STATE_NAMES
-from htetro_opt.problems import FITNESS_NAMES
-from htetro_opt.problems import SequencingInstance, check_weights
+from htetro_opt.problems import FITNESS_NAMES, SequencingInstance, check_weights
 from htetro_opt.scenarios import (
     Scenario,
     format_tileset,
@@ -35,51 +39,50 @@ from htetro_opt.scenarios import (
     scenario_path,
     tileset_path,
 )
-from htetro_opt.solvers import (
-    GA_ALGORITHMS,
-    SEQUENCE_SOLVERS,
-    TILING_SOLVERS,
-    plan_exact,
-    plan_ga,
-    sequence_waypoints,
-    tile_workspace,
-)
+from htetro_opt.solvers.grid_paths import EXACT_METHODS, PLAN_METHODS, plan_path
+from htetro_opt.solvers.sequencing import SEQUENCE_METHODS, sequence_waypoints
+from htetro_opt.solvers.tiling import TILING_METHODS, tile_workspace
 
 __all__ = ["main", "main_entry", "build_parser"]
 
+# The Table-4 study's maps, named here so that building the parser does not import the study.
+_STUDY_ENVIRONMENTS = ("random", "spiral", "h_shape", "three_slit", "perpendicular_dynamic", "parallel_dynamic")
+
 EXIT_ERROR = 2
-PLAN_METHODS = {"exact": "dijkstra", "astar": "astar", "nsga2": "ga"}
+GA_DEFAULTS = {"pop_size": 50, "max_gen": 1000, "patience": 100, "max_length": 100, "seed": 0}
+"""Defaults of ``plan``'s GA options (None in the parser, so that one given to an exact method is refused)."""
 TILING_TIME_LIMIT = 60.0  # the backtracker can search long on cluttered maps with few allowed shapes
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(prog="htetro-opt", description="Path planning for the hTetro reconfigurable robot.")
     parser.add_argument("--version", action="version", version=f"htetro-opt {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
+    sub = parser.add_subparsers(dest="command", parser_class=Parser, metavar="COMMAND")
 
     p = sub.add_parser("scenarios", help="list the bundled scenarios")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
     p = sub.add_parser("plan", help="plan a path through a scenario's roadmap")
     p.add_argument("scenario", help="bundled scenario name or path to a scenario TOML file")
-    p.add_argument("--method", choices=sorted(PLAN_METHODS), default="exact",
-                   help="exact: minimum-time Dijkstra (default); astar: A*, same optimum; "
-                        "nsga2: seed 000's multi-objective GA over command chromosomes")
-    p.add_argument("--algorithm", choices=GA_ALGORITHMS, default="htetro",
-                   help="with --method nsga2: the paper's hTetro-GA (default) or one of pymoo's algorithms")
-    p.add_argument("--pop-size", type=int, default=50, help="with --method nsga2: population size n_pop (default 50)")
-    p.add_argument("--max-gen", type=int, default=1000,
-                   help="with --method nsga2: generations per roadmap leg at most (default 1000)")
-    p.add_argument("--patience", type=int, default=100,
-                   help="with --method nsga2: stop a leg after this many generations without improvement "
-                        "once its goal is reached (default 100)")
-    p.add_argument("--max-length", type=int, default=100,
-                   help="with --method nsga2: l_p,max, the initial chromosome length (default 100)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (the exact methods are deterministic)")
-    p.add_argument("--diagonals", action="store_true", help="allow diagonal translations")
-    p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block")
+    p.add_argument("--method", choices=PLAN_METHODS, default="dijkstra",
+                   help="dijkstra (default), astar: the minimum-time plan (the same optimum); htetro-ga: the "
+                        "multi-objective GA over command chromosomes of Cheng et al. 2020 with our additions "
+                        "(htetro-ga-paper: as published); nsga2, nsga3, smsemoa, agemoea: pymoo's algorithms "
+                        "on the same problem")
+    p.add_argument("--pop-size", type=int, help=f"GA methods: population size n_pop (default {GA_DEFAULTS['pop_size']})")
+    p.add_argument("--max-gen", type=int,
+                   help=f"GA methods: generations per roadmap leg at most (default {GA_DEFAULTS['max_gen']})")
+    p.add_argument("--patience", type=int,
+                   help="GA methods: stop a leg after this many generations without improvement "
+                        f"once its goal is reached (default {GA_DEFAULTS['patience']})")
+    p.add_argument("--max-length", type=int,
+                   help=f"GA methods: l_p,max, the initial chromosome length (default {GA_DEFAULTS['max_length']})")
+    p.add_argument("--seed", type=int,
+                   help=f"GA methods: random seed, the same seed giving the same plan (default {GA_DEFAULTS['seed']})")
+    p.add_argument("--diagonals", action="store_true", help="dijkstra, astar: allow diagonal translations")
+    p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--plot", metavar="FILE", help="save a PNG of the map and the path")
+    p.add_argument("--plot", metavar="FILE", help="save a plot of the map and the path (format from the extension)")
 
     p = sub.add_parser(
         "simulate",
@@ -93,36 +96,38 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--commands", required=True, help='comma- or space-separated tokens, e.g. "x+,x+,sI"')
     p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--plot", metavar="FILE", help="save a PNG of the map and the executed path")
+    p.add_argument("--plot", metavar="FILE", help="save a plot of the map and the executed path")
 
     p = sub.add_parser(
         "tile",
-        help="tile a scenario's free cells with tetrominoes (seed 003) and label the waypoints",
+        help="tile a scenario's free cells with tetrominoes (Le et al. 2018) and label the waypoints",
         description="Tile the free cells of a grid scenario with the robot's tetrominoes and label every "
-        "tile's blocks a-d by Algorithm 1 of seed 003. Writes the labelled tileset (to --out, or prints it).",
+        "tile's blocks a-d by Algorithm 1 of Le et al. 2018. Writes the labelled tileset (to --out, or prints it).",
     )
     p.add_argument("scenario", help="bundled scenario name or path to a scenario TOML file")
     p.add_argument("--shapes", help="allowed morphologies, e.g. TZ or O (default: all seven, IOLJZST)")
-    p.add_argument("--solver", choices=TILING_SOLVERS, default="backtracking",
+    p.add_argument("--method", choices=TILING_METHODS, default="backtracking",
                    help="backtracking: the paper's search (default); cpsat: exact cover with OR-Tools CP-SAT")
     p.add_argument("--overlap", action="store_true",
-                   help="if the map cannot be tiled, cover it by two overlapping sub-workspaces (seed 003 Fig. 5)")
-    p.add_argument("--seed", type=int, help="shuffle the placement order, for another tiling")
+                   help="if the map cannot be tiled, cover it by two overlapping sub-workspaces (the paper's Fig. 5)")
+    p.add_argument("--shuffle", action="store_true",
+                   help="shuffle the placement order by --seed, for another tiling (default: the fixed order)")
+    p.add_argument("--seed", type=int, help="with --shuffle: its random seed (default 0)")
     p.add_argument("--time-limit", type=float, default=TILING_TIME_LIMIT,
                    help=f"give up after this many seconds (default {TILING_TIME_LIMIT:g})")
     p.add_argument("--out", metavar="FILE", help="write the labelled tileset to FILE")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--plot", metavar="FILE", help="save a PNG of the tileset")
+    p.add_argument("--plot", metavar="FILE", help="save a plot of the tileset (format from the extension)")
 
     p = sub.add_parser(
         "sequence",
-        help="order a tileset's waypoints (seed 003's TSP) with one solver",
+        help="order a tileset's waypoints (the TSP of Le et al. 2018) with one method",
         description="Order the waypoints of a labelled tileset as an open path from a start tile, "
         "minimising the eq.-2 cost (weighted displacement of the blocks a-d). TILESET is a labelled "
         "tileset (bundled name or file) or a scenario, which is tiled first.",
     )
     p.add_argument("tileset", help="labelled tileset (bundled name or file) or scenario (name or .toml)")
-    p.add_argument("--solver", choices=SEQUENCE_SOLVERS, default="auto",
+    p.add_argument("--method", choices=SEQUENCE_METHODS, default="auto",
                    help="auto (default): exact up to 40 waypoints, local search beyond; ga: the paper's GA "
                         "on DEAP with a 2-opt/Or-opt step (ga-plain: without); ortools: routing with "
                         "guided local search; exact: CP-SAT optimum (<= 40 waypoints); local: nearest "
@@ -130,11 +135,38 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--start", default="1", help="label of the start tile (default 1), or 'free'")
     p.add_argument("--weights", default="0.25,0.25,0.25,0.25",
                    help="eq. 2's weights α,β,λ,γ of blocks a,b,c,d (default 0.25 each)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (deterministic solvers ignore it)")
-    p.add_argument("--time-limit", type=float, help="time budget in seconds (exact, ortools, ga, local)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0; deterministic methods ignore it)")
+    p.add_argument("--time-limit", type=float,
+                   help="time budget in seconds (exact: 60 by default; ortools: 1 s up to 20 waypoints, "
+                        "rising to 30 s at 40 and beyond; ga, local, greedy: none)")
     p.add_argument("--shapes", help="when TILESET is a scenario: allowed morphologies for the tiling")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--plot", metavar="FILE", help="save a PNG of the tileset and the order")
+    p.add_argument("--plot", metavar="FILE", help="save a plot of the tileset and the order (format from the extension)")
+    p = sub.add_parser(
+        "study",
+        help="re-run a paper's experiment, our numbers beside the paper's",
+        description="Re-run a paper's experiment on the bundled maps and print our numbers beside the paper's, "
+        "with the exact optimum and every method's gap to it.",
+    )
+    studies = p.add_subparsers(dest="study", required=True, parser_class=Parser)
+    q = studies.add_parser("table4", help="Cheng et al. 2020, Table 4: the hTetro-GA on six maps × three n_pop")
+    q.add_argument("--envs", default=",".join(_STUDY_ENVIRONMENTS),
+                   help=f"comma-separated environments (default all: {','.join(_STUDY_ENVIRONMENTS)})")
+    q.add_argument("--pop-sizes", default="25,50,100", help="comma-separated population sizes (default 25,50,100)")
+    q.add_argument("--seeds", type=int, default=50, help="number of seeds, 0 … N−1 (default 50)")
+    q.add_argument("--max-gen", type=int, default=1000, help="generation cap per leg (default 1000)")
+    q.add_argument("--patience", type=int, default=100,
+                   help="generations without improvement that end a leg (default 100)")
+    q.add_argument("--method", choices=GA_ALGORITHMS, default="htetro-ga", help="the GA (default htetro-ga)")
+    q.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
+    q.add_argument("--out", metavar="DIR", help="write DIR/table4.csv and DIR/table4.md")
+    q.add_argument("--progress", action="store_true", help="report each finished trial on stderr")
+    q.add_argument("--json", action="store_true", help="print one JSON object (the records) instead of the table")
+    q = studies.add_parser("seed003", help="Le et al. 2018, Tables 1–5: tiling and waypoint sequencing")
+    q.add_argument("--seeds", type=int, default=5, help="seeds of the stochastic methods (default 5)")
+    q.add_argument("--time-limit", type=float, help="cap in seconds for each method that takes one")
+    q.add_argument("--out", metavar="DIR", help="write DIR/seed003.md and DIR/seed003.csv")
+    q.add_argument("--json", action="store_true", help="print one JSON object (the records) instead of the report")
     return parser
 
 
@@ -151,9 +183,18 @@ def _pose_dict(row) -> dict:
 
 
 def _check_clearance(value: float) -> float:
-    if not 0 <= value < 10:
-        raise ParameterError(f"--clearance must be between 0 and 10 cells, got {value:g}")
-    return value
+    return check_real(value, "--clearance (cells)", minimum=0.0, maximum=10.0, include_maximum=False)
+
+
+def _outputs(args, *names: tuple[str, str]) -> None:
+    """Check every output path of a command before any work starts."""
+    for attribute, what in names:
+        if getattr(args, attribute, None):
+            check_output_path(getattr(args, attribute), what=what)
+    if getattr(args, "plot", None):
+        from htetro_opt.viz import figure_format
+
+        figure_format(args.plot)
 
 
 def _cmd_scenarios(args) -> dict:
@@ -186,39 +227,44 @@ def _cmd_scenarios(args) -> dict:
 def _cmd_plan(args) -> dict:
     scenario = _grid_scenario(args.scenario)
     clearance = _check_clearance(args.clearance)
+    _outputs(args, ("plot", "plot"))
     if scenario.goal is None:
         raise PlanningError(f"scenario {scenario.name!r} has no roadmap with a start and a goal to plan for")
-    began = time.perf_counter()
-    genetic = args.method == "nsga2"
+    genetic = args.method not in EXACT_METHODS
+    given = {name: getattr(args, name) for name in GA_DEFAULTS if getattr(args, name) is not None}
     if genetic:
         if args.diagonals:
-            raise ParameterError("--diagonals is not available with --method nsga2 (seed 000 has no diagonal commands)")
-        for flag, value, least in (("--pop-size", args.pop_size, 2), ("--max-gen", args.max_gen, 1),
-                                   ("--patience", args.patience, 1), ("--max-length", args.max_length, 1)):
-            if value < least:
-                raise ParameterError(f"{flag} must be at least {least}, got {value}")
-        plan = plan_ga(scenario.workspace, scenario.roadmap, algorithm=args.algorithm, pop_size=args.pop_size,
-                       max_gen=args.max_gen, patience=args.patience, max_length=args.max_length,
-                       seed=args.seed, clearance=clearance)
+            raise ParameterError(f"--diagonals is not available with --method {args.method} "
+                                 "(the command chromosomes of Cheng et al. 2020 have no diagonal commands)")
+        for name, default in GA_DEFAULTS.items():
+            setattr(args, name, given.get(name, default))
+        options = dict(pop_size=check_int(args.pop_size, "--pop-size", minimum=2),
+                       max_gen=check_int(args.max_gen, "--max-gen", minimum=1),
+                       patience=check_int(args.patience, "--patience", minimum=1),
+                       max_length=check_int(args.max_length, "--max-length", minimum=1),
+                       seed=check_seed(args.seed, "--seed"))
     else:
-        plan = plan_exact(scenario.workspace, scenario.roadmap, diagonals=args.diagonals,
-                          clearance=clearance, algorithm=PLAN_METHODS[args.method])
-    runtime = time.perf_counter() - began
+        if given:
+            flags = ", ".join("--" + name.replace("_", "-") for name in given)
+            raise ParameterError(f"{flags} applies to the GA methods only, not to --method {args.method} "
+                                 "(an exact method has no population, generations or randomness)")
+        options = dict(diagonals=args.diagonals)
+    plan = plan_path(scenario.workspace, scenario.roadmap, method=args.method, clearance=clearance, **options)
     out = {
         "scenario": scenario.name,
-        "method": args.method,
+        "method": plan.method,
         "reached": plan.reached,
         "commands": plan.tokens,
         "time": plan.time,
         "objectives": plan.objectives(),
-        "runtime_s": round(runtime, 6),
+        "runtime_s": round(plan.runtime_s, 6),
     }
     if genetic:
         out.update(_ga_fields(plan, args))
     if args.plot:
         from htetro_opt.viz import plot_ga_plan, plot_path, save_figure
 
-        method = f"{args.method} ({args.algorithm}, n_pop {args.pop_size}, seed {args.seed})" if genetic else args.method
+        method = f"{args.method} (n_pop {args.pop_size}, seed {args.seed})" if genetic else args.method
         status = "reached" if plan.reached else f"goal NOT reached (leg {plan.failed_leg + 1} {'not solved' if genetic else 'has no path'})"
         title = f"{scenario.name}: {method}, time {plan.time:g}, {len(plan.tokens)} commands, {status}"
         if genetic:
@@ -230,11 +276,13 @@ def _cmd_plan(args) -> dict:
         legs = len(scenario.roadmap) - 1
         failure = "was not solved" if genetic else "has no path"
         status = "reached" if plan.reached else f"NOT reached: leg {plan.failed_leg + 1} of {legs} {failure}"
-        print(f"{scenario.name}: {status} ({args.method}, {runtime:.3f} s); time {plan.time:g}, "
+        print(f"{scenario.name}: {status} ({plan.method}, {plan.runtime_s:.3f} s); time {plan.time:g}, "
               f"{len(plan.tokens)} commands")
         if genetic:
             fitness = ", ".join(f"{k} {v:.3f}" for k, v in out["fitness"].items())
-            print(f"generations {out['generations']}, goal first reached in generation {out['reach_generation']}; "
+            first = out["reach_generation"]
+            print(f"generations {out['generations']}, goal first reached "
+                  f"{'in generation ' + str(first) if first is not None else 'in no generation'}; "
                   f"multi-objective solution: {fitness}; leading front: {len(out['front'])} members")
         if plan.tokens:
             print(" ".join(plan.tokens))
@@ -259,7 +307,6 @@ def _ga_fields(plan, args) -> dict:
     ]
     fitness = np.mean([leg.selected["multi_objective"].fitness for leg in plan.legs], axis=0)
     return {
-        "algorithm": args.algorithm,
         "pop_size": args.pop_size,
         "seed": args.seed,
         "reach_generation": plan.reach_generation,
@@ -273,6 +320,7 @@ def _ga_fields(plan, args) -> dict:
 def _cmd_simulate(args) -> dict:
     scenario = _grid_scenario(args.scenario)
     clearance = _check_clearance(args.clearance)
+    _outputs(args)
     if scenario.start is None:
         raise PlanningError(f"scenario {scenario.name!r} has no start configuration to simulate from")
     sequence = parse_commands(args.commands)
@@ -293,46 +341,50 @@ def _cmd_simulate(args) -> dict:
     if args.plot:
         from htetro_opt.viz import plot_path, save_figure
 
-        state = "valid" if out["valid"] else f"invalid at command {first_invalid + 1}"
+        state = "valid" if out["valid"] else f"invalid at command index {first_invalid} (0-based)"
         title = f"{scenario.name}: {out['executed']} of {len(sequence)} commands executed ({state})"
         save_figure(plot_path(world, result.poses(0), roadmap=scenario.roadmap,
                               hidden=scenario.hidden, title=title), args.plot)
     if not args.json:
         f = out["final"]
-        print(f"{'valid' if out['valid'] else 'INVALID at command ' + str(first_invalid + 1)}; "
+        print(f"{'valid' if out['valid'] else f'INVALID at command index {first_invalid} (0-based)'}; "
               f"executed {out['executed']} of {len(sequence)}; reached: {out['reached']}; "
               f"final ({f['x']}, {f['y']}) {f['shape']} heading {f['heading']}; time {out['time']:g}")
     return out
 
 
-def _time_limit(value: float | None) -> float | None:
-    if value is not None and not value > 0:
-        raise ParameterError(f"--time-limit must be positive, got {value:g}")
-    return value
-
-
-def _tileset_of_scenario(name: str, *, shapes, solver="backtracking", seed=None, time_limit=None, overlap=False):
+def _tileset_of_scenario(name: str, *, shapes, method="backtracking", shuffle=False, seed=None,
+                         time_limit=TILING_TIME_LIMIT, overlap=False):
     scenario = _grid_scenario(name)
-    return tile_workspace(scenario.workspace, shapes=shapes, solver=solver, seed=seed, time_limit=time_limit,
-                          overlap=overlap, name=scenario.name)
+    return tile_workspace(scenario.workspace, shapes=shapes, method=method, shuffle=shuffle, seed=seed,
+                          time_limit=time_limit, overlap=overlap, name=scenario.name)
 
 
 def _cmd_tile(args) -> dict:
-    time_limit = _time_limit(args.time_limit)
+    time_limit = check_time_limit(args.time_limit, "--time-limit")
+    if args.seed is not None and not args.shuffle:
+        raise ParameterError("--seed applies only with --shuffle (without it the tiling is the same every time)")
+    seed = check_seed(0 if args.seed is None else args.seed, "--seed")
+    _outputs(args, ("out", "tileset"), ("plot", "plot"))
     shapes = list(args.shapes) if args.shapes else None
     began = time.perf_counter()
-    tileset = _tileset_of_scenario(args.scenario, shapes=shapes, solver=args.solver, seed=args.seed,
-                                   time_limit=time_limit, overlap=args.overlap)
+    tileset = _tileset_of_scenario(args.scenario, shapes=shapes, method=args.method, shuffle=args.shuffle,
+                                   seed=seed, time_limit=time_limit, overlap=args.overlap)
     runtime = time.perf_counter() - began
-    if args.out:
-        save_tileset(tileset, args.out)
     counts = {shape: tileset.shapes.count(shape) for shape in sorted(set(tileset.shapes))}
-    out = {"scenario": tileset.name, "solver": args.solver, "tiles": len(tileset), "shapes": counts,
+    out = {"scenario": tileset.name, "method": args.method, "tiles": len(tileset), "shapes": counts,
            "overlapping": tileset.overlapping, "runtime_s": round(runtime, 6), "out": args.out}
-    if args.plot:
+    if args.plot:  # before the tileset file: a failed plot leaves no tileset written either
         from htetro_opt.viz import plot_tileset, save_figure
 
-        save_figure(plot_tileset(tileset, title=f"{tileset.name}: {len(tileset)} tiles ({args.solver})"), args.plot)
+        save_figure(plot_tileset(tileset, title=f"{tileset.name}: {len(tileset)} tiles ({args.method})"), args.plot)
+    if args.out:
+        try:
+            save_tileset(tileset, args.out)
+        except HtetroError:
+            if args.plot:
+                os.unlink(args.plot)
+            raise
     if args.json:
         if not args.out:
             out["tileset"] = format_tileset(tileset)
@@ -353,7 +405,9 @@ def _is_scenario(name: str) -> bool:
 
 
 def _cmd_sequence(args) -> dict:
-    time_limit = _time_limit(args.time_limit)
+    time_limit = check_time_limit(args.time_limit, "--time-limit")
+    seed = check_seed(args.seed, "--seed")
+    _outputs(args, ("plot", "plot"))
     try:
         weights = check_weights([float(v) for v in args.weights.split(",")])
     except ValueError as err:
@@ -367,41 +421,123 @@ def _cmd_sequence(args) -> dict:
             raise ParameterError(f"--start must be a tile label or 'free', got {args.start!r}") from err
     if _is_scenario(args.tileset):
         scenario_path(args.tileset)  # a clear error for a missing file
-        tileset = _tileset_of_scenario(args.tileset, shapes=list(args.shapes) if args.shapes else None,
-                                       time_limit=TILING_TIME_LIMIT)
+        tileset = _tileset_of_scenario(args.tileset, shapes=list(args.shapes) if args.shapes else None)
     else:
         if args.shapes:
             raise ParameterError("--shapes applies only when TILESET is a scenario to tile")
         tileset = load_tileset(tileset_path(args.tileset))
     instance = SequencingInstance.from_tileset(tileset, start=start, weights=weights)
-    result = sequence_waypoints(instance, args.solver, seed=args.seed, time_limit=time_limit)
+    result = sequence_waypoints(instance, method=args.method, seed=seed, time_limit=time_limit)
     out = {"tileset": tileset.name, "waypoints": instance.n, "start": args.start, "weights": weights.tolist(),
            **result.as_dict()}
     if args.plot:
         from htetro_opt.viz import plot_tileset, save_figure
 
-        title = f"{tileset.name}: {result.solver}, cost {result.cost:.3f}"
+        title = f"{tileset.name}: {result.method}, cost {result.cost:.3f}"
         save_figure(plot_tileset(tileset, order=result.tiles, title=title), args.plot)
     if not args.json:
-        print(f"{tileset.name}: {instance.n} waypoints, {result.solver}, cost {result.cost:.4f} "
+        print(f"{tileset.name}: {instance.n} waypoints, {result.method}, cost {result.cost:.4f} "
               f"in {result.runtime_s:.3f} s")
         print(" ".join(str(t) for t in result.tiles))
     return out
 
 
+def _int_list(text: str, flag: str) -> list[int]:
+    try:
+        values = [int(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ParameterError(f"{flag} must be comma-separated integers, got {text!r}") from None
+    if not values:
+        raise ParameterError(f"{flag} must name at least one integer")
+    return values
+
+
+def _study_folder(out: str | None) -> Path | None:
+    """The results folder, checked before the study runs: a folder, or creatable inside a writable one."""
+    if not out:
+        return None
+    folder = Path(out)
+    if folder.exists() and not folder.is_dir():
+        raise ParameterError(f"--out {out!r} is a file, not a folder")
+    existing = folder
+    while not existing.exists():
+        existing = existing.parent
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise ParameterError(f"--out {out!r}: cannot write in {str(existing)!r}")
+    return folder
+
+
+def _cmd_study(args) -> dict:
+    check_int(args.seeds, "--seeds", minimum=1)
+    out = _study_folder(args.out)
+    if args.study == "table4":
+        from htetro_opt.studies import table4
+
+        envs = [v.strip() for v in args.envs.split(",") if v.strip()]
+        options = dict(max_gen=check_int(args.max_gen, "--max-gen", minimum=1),
+                       patience=check_int(args.patience, "--patience", minimum=1),
+                       method=args.method, jobs=check_int(args.jobs, "--jobs", minimum=1))
+        pop_sizes = [check_int(n, "--pop-sizes", minimum=2) for n in _int_list(args.pop_sizes, "--pop-sizes")]
+
+        def report(done: int, total: int, record: dict) -> None:
+            print(f"[{done}/{total}] {record['environment']} n_pop={record['pop_size']} seed={record['seed']}: "
+                  f"{'reached' if record['reached'] else 'not reached'} in "
+                  f"{record['terminate_generation']} generations, {record['terminate_time_s']:.1f} s",
+                  file=sys.stderr, flush=True)
+
+        records = table4.run_study(envs, pop_sizes, range(args.seeds), progress=report if args.progress else None,
+                                   **options)
+        text = table4.markdown_table(table4.summarise(records))
+        if out is not None:
+            out.mkdir(parents=True, exist_ok=True)
+            table4.write_csv(records, out / "table4.csv")
+            write_text(out / "table4.md", text, what="study table")
+    else:
+        from htetro_opt.studies import seed003
+
+        time_limit = check_time_limit(args.time_limit, "--time-limit")
+        records = seed003.run_study(seeds=range(args.seeds), time_limit=time_limit,
+                                    progress=lambda message: print(message, file=sys.stderr, flush=True))
+        text = seed003.markdown_report(records) + "\n"
+        if out is not None:
+            out.mkdir(parents=True, exist_ok=True)
+            seed003.write_csv(records, out / "seed003.csv")
+            write_text(out / "seed003.md", text, what="study report")
+    if not args.json:
+        print(text, end="")
+    return {"study": args.study, "records": records, "out": None if out is None else str(out)}
+
+
 _COMMANDS = {"scenarios": _cmd_scenarios, "plan": _cmd_plan, "simulate": _cmd_simulate,
-             "tile": _cmd_tile, "sequence": _cmd_sequence}
+             "tile": _cmd_tile, "sequence": _cmd_sequence, "study": _cmd_study}
+
+
+class Terminated(BaseException):
+    """SIGTERM, turned into an exception so that ``finally`` blocks (temporary files) run."""
+
+
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
+EXIT_TERMINATED = 143  # 128 + SIGTERM
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI; returns the exit status (0 success, 2 error)."""
+    """Run the CLI; returns the exit status (0 success, 2 error, 130 interrupted, 143 terminated)."""
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
+        if args.command is None:
+            parser.print_help(sys.stderr)
+            return EXIT_ERROR
         out = _COMMANDS[args.command](args)
     except (UsageError, HtetroError) as err:
         print("error: " + " ".join(str(err).split()), file=sys.stderr)
         return EXIT_ERROR
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Terminated:
+        print("terminated", file=sys.stderr)
+        return EXIT_TERMINATED
     except SystemExit as done:  # --help and --version
         return int(done.code or 0)
     if getattr(args, "json", False):
@@ -409,16 +545,23 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 0
 
 
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+def _terminate(signum, frame) -> None:
+    raise Terminated()
 
 
 def main_entry() -> None:
-    """Console-script entry point."""
+    """Console-script entry point: SIGTERM ends the command like Ctrl-C, one line and no traceback."""
+    signal.signal(signal.SIGTERM, _terminate)
     try:
         code = main()
         sys.stdout.flush()
     except BrokenPipeError:  # output piped into e.g. `head`, which closed it: not an error of ours
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         code = 1
+    except KeyboardInterrupt:  # a second Ctrl-C while the first was being handled
+        code = EXIT_INTERRUPTED
     sys.exit(code)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main_entry()

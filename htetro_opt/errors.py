@@ -18,6 +18,7 @@ __all__ = [
     "ParameterError",
     "TilesetFormatError",
     "TilingError",
+    "OutputError",
 ]
 
 
@@ -65,3 +66,8 @@ class TilingError(PlanningError):
 
 class ParameterError(HtetroError, ValueError):
     """An option has an invalid value: a negative clearance or duration, an empty command set."""
+
+
+class OutputError(HtetroError, OSError):
+    """An output file (a tileset, plot, study table) cannot be written: a missing folder, a folder in
+    the way, no permission, a full disk."""

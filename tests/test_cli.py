@@ -111,7 +111,7 @@ def near(tmp_path) -> str:
 def test_plan_json_keys_and_optimal_time(plan_out):
     assert set(plan_out) == {"scenario", "method", "reached", "commands", "time", "objectives", "runtime_s"}
     assert plan_out["scenario"] == "room"
-    assert plan_out["method"] == "exact"
+    assert plan_out["method"] == "dijkstra"
     assert plan_out["reached"] is True
     assert isinstance(plan_out["commands"], list) and all(isinstance(t, str) for t in plan_out["commands"])
     # Lower bound: 7 unit translations (Manhattan distance of B2), one rotation (2.0: the goal heading
@@ -221,7 +221,7 @@ def test_simulate_empty_sequence(capsys, near):
 def test_simulate_text_output(capsys, near):
     code, out, err = run(capsys, ["simulate", near, "--commands", "x+ x+ x+ x+ x+ x+"])
     assert code == 0 and err == ""
-    assert "INVALID at command 6" in out and "executed 5 of 6" in out
+    assert "INVALID at command index 5 (0-based)" in out and "executed 5 of 6" in out
 
 
 def test_simulate_plot(capsys, tmp_path, near):
@@ -317,8 +317,15 @@ def test_plan_on_continuous_scenario(capsys, tmp_path):
     assert_one_error_line(*run(capsys, ["plan", str(path)]), "continuous")
 
 
+def test_no_command_shows_the_usage_and_the_commands(capsys):
+    code, out, err = run(capsys, [])
+    assert code == 2 and out == ""
+    assert err.startswith("usage: htetro-opt") and "Traceback" not in err
+    for command in ("scenarios", "plan", "simulate", "tile", "sequence", "study"):
+        assert command in err
+
+
 @pytest.mark.parametrize("argv,words", [
-    ([], ["required"]),
     (["plan"], ["required", "scenario"]),
     (["simulate", "{near}"], ["required", "--commands"]),
     (["plan", "{near}", "--bogus"], ["unrecognized", "--bogus"]),
@@ -383,9 +390,9 @@ def test_simulate_runs_in_the_true_world_and_plan_in_the_known_map(capsys, tmp_p
 
 
 # --------------------------------------------------------------------------------------------------
-# plan --method nsga2 (seed 000's GA)
+# plan with the GAs over command chromosomes (Cheng et al. 2020)
 
-GA_FAST = ["--method", "nsga2", "--pop-size", "16", "--max-gen", "60", "--patience", "20", "--max-length", "20"]
+GA_FAST = ["--method", "htetro-ga", "--pop-size", "16", "--max-gen", "60", "--patience", "20", "--max-length", "20"]
 
 
 @pytest.fixture(scope="module")
@@ -402,12 +409,12 @@ def ga_out(room):
     return str(near_goal), json.loads(out.getvalue())
 
 
-def test_plan_nsga2_json_fields(ga_out):
+def test_plan_ga_json_fields(ga_out):
     _, out = ga_out
     exact_keys = {"scenario", "method", "reached", "commands", "time", "objectives", "runtime_s"}
     assert exact_keys <= set(out)
     assert {"reach_generation", "front", "legs", "fitness", "generations"} <= set(out)
-    assert out["method"] == "nsga2" and out["algorithm"] == "htetro"
+    assert out["method"] == "htetro-ga"
     assert out["reached"] is True and out["fitness"]["f_gr"] == 1.0
     assert 1 <= out["reach_generation"] <= out["generations"]
     assert out["front"], "the leading front is listed"
@@ -422,20 +429,20 @@ def test_plan_nsga2_json_fields(ga_out):
     assert selected["commands"] in [m["commands"] for m in out["front"]]
 
 
-def test_plan_nsga2_commands_replay_in_simulate(capsys, ga_out):
+def test_plan_ga_commands_replay_in_simulate(capsys, ga_out):
     path, out = ga_out
     replay = run_json(capsys, ["simulate", path, "--commands", ",".join(out["commands"]), "--json"])
     assert replay["valid"] and replay["reached"]
     assert replay["time"] == pytest.approx(out["time"])
 
 
-def test_plan_nsga2_same_seed_same_plan(capsys, ga_out):
+def test_plan_ga_same_seed_same_plan(capsys, ga_out):
     path, out = ga_out
     again = run_json(capsys, ["plan", path, *GA_FAST, "--seed", "4", "--json"])
     assert again["commands"] == out["commands"] and again["front"] == out["front"]
 
 
-def test_plan_nsga2_text_and_plot(capsys, tmp_path, ga_out):
+def test_plan_ga_text_and_plot(capsys, tmp_path, ga_out):
     path, _ = ga_out
     png = tmp_path / "ga.png"
     code, out, err = run(capsys, ["plan", path, *GA_FAST, "--seed", "4", "--plot", str(png)])
@@ -444,21 +451,21 @@ def test_plan_nsga2_text_and_plot(capsys, tmp_path, ga_out):
     assert png.read_bytes().startswith(PNG_SIGNATURE)
 
 
-@pytest.mark.parametrize("algorithm", ["nsga2", "nsga3"])
-def test_plan_nsga2_with_pymoo_algorithms(capsys, ga_out, algorithm):
+@pytest.mark.parametrize("method", ["nsga2", "nsga3"])
+def test_plan_with_pymoo_algorithms(capsys, ga_out, method):
     path, _ = ga_out
-    out = run_json(capsys, ["plan", path, *GA_FAST, "--algorithm", algorithm, "--json"])
-    assert out["algorithm"] == algorithm and out["front"]
+    out = run_json(capsys, ["plan", path, *GA_FAST, "--method", method, "--json"])
+    assert out["method"] == method and out["front"]
 
 
 @pytest.mark.parametrize("option,value", [("--pop-size", "1"), ("--max-gen", "0"), ("--patience", "0"),
                                           ("--max-length", "0")])
-def test_plan_nsga2_bad_options_are_one_error_line(capsys, near, option, value):
-    assert_one_error_line(*run(capsys, ["plan", near, "--method", "nsga2", option, value]), option, value)
+def test_plan_ga_bad_options_are_one_error_line(capsys, near, option, value):
+    assert_one_error_line(*run(capsys, ["plan", near, "--method", "htetro-ga", option, value]), option, value)
 
 
-def test_plan_nsga2_unknown_algorithm_is_a_usage_error(capsys, near):
-    assert_one_error_line(*run(capsys, ["plan", near, "--method", "nsga2", "--algorithm", "moead"]), "moead")
+def test_plan_unknown_method_is_a_usage_error(capsys, near):
+    assert_one_error_line(*run(capsys, ["plan", near, "--method", "moead"]), "moead")
 
 
 # --------------------------------------------------------------------------------------------------
@@ -483,7 +490,7 @@ def test_tile_writes_a_labelled_tileset_that_covers_the_map(capsys, tmp_path):
 
 def test_tile_prints_the_tileset_and_honours_allowed_shapes(capsys, tmp_path):
     path = scenario(tmp_path / "square.toml", grid="....\n....\n....\n....")
-    code, out, err = run(capsys, ["tile", path, "--shapes", "O", "--solver", "cpsat"])
+    code, out, err = run(capsys, ["tile", path, "--shapes", "O", "--method", "cpsat"])
     assert code == 0 and err == ""
     rows = [line.split() for line in out.splitlines()]
     assert len(rows) == 4 and all(len(r) == 4 for r in rows)
@@ -506,8 +513,8 @@ def test_tile_unknown_shape_is_one_error_line(capsys, tmp_path):
 
 
 def test_sequence_a_bundled_paper_tileset_exactly(capsys):
-    out = run_json(capsys, ["sequence", "paper_6x6_fig13a", "--solver", "exact", "--json"])
-    assert set(out) >= {"order", "cost", "runtime_s", "solver", "optimal"}
+    out = run_json(capsys, ["sequence", "paper_6x6_fig13a", "--method", "exact", "--json"])
+    assert set(out) >= {"order", "cost", "runtime_s", "method", "optimal"}
     assert sorted(out["order"]) == list(range(1, 10)) and out["order"][0] == 1
     assert out["optimal"] is True
     # the reported cost is the eq.-2 cost of the reported order
@@ -517,7 +524,7 @@ def test_sequence_a_bundled_paper_tileset_exactly(capsys):
     inst = SequencingInstance.from_tileset(load_tileset(tileset_path("paper_6x6_fig13a")))
     assert out["cost"] == pytest.approx(inst.path_cost([inst.ids.index(t) for t in out["order"]]))
     for solver in ("ortools", "ga", "local"):
-        other = run_json(capsys, ["sequence", "paper_6x6_fig13a", "--solver", solver, "--time-limit", "2", "--json"])
+        other = run_json(capsys, ["sequence", "paper_6x6_fig13a", "--method", solver, "--time-limit", "2", "--json"])
         if solver == "local":  # a heuristic: no better than the optimum
             assert other["cost"] >= out["cost"] - 1e-9
         else:
@@ -526,31 +533,31 @@ def test_sequence_a_bundled_paper_tileset_exactly(capsys):
 
 @pytest.mark.parametrize("solver", ["zigzag", "zigzag2", "spiral", "spiral2", "greedy", "ga-plain"])
 def test_sequence_baselines_visit_every_tile_once_from_the_start(capsys, solver):
-    out = run_json(capsys, ["sequence", "paper_11x11_fig13d", "--solver", solver, "--start", "5",
+    out = run_json(capsys, ["sequence", "paper_11x11_fig13d", "--method", solver, "--start", "5",
                             "--seed", "3", "--json"])
     assert out["order"][0] == 5 and sorted(out["order"]) == list(range(1, 29))
 
 
 def test_sequence_a_scenario_tiles_it_first_and_free_start_is_no_worse(capsys, tmp_path):
     path = scenario(tmp_path / "strip.toml", grid=STRIP)
-    fixed = run_json(capsys, ["sequence", path, "--solver", "exact", "--json"])
-    free = run_json(capsys, ["sequence", path, "--solver", "exact", "--start", "free", "--json"])
+    fixed = run_json(capsys, ["sequence", path, "--method", "exact", "--json"])
+    free = run_json(capsys, ["sequence", path, "--method", "exact", "--start", "free", "--json"])
     assert fixed["waypoints"] == free["waypoints"] == 7
     assert free["cost"] <= fixed["cost"] + 1e-9
 
 
 def test_sequence_same_seed_same_order_and_plot(capsys, tmp_path):
-    argv = ["sequence", "paper_8x7_fig13b", "--solver", "ga-plain", "--seed", "7", "--json"]
+    argv = ["sequence", "paper_8x7_fig13b", "--method", "ga-plain", "--seed", "7", "--json"]
     assert run_json(capsys, argv)["order"] == run_json(capsys, argv)["order"]
     png = tmp_path / "seq.png"
-    code, out, err = run(capsys, ["sequence", "paper_8x7_fig13b", "--solver", "spiral", "--plot", str(png)])
+    code, out, err = run(capsys, ["sequence", "paper_8x7_fig13b", "--method", "spiral", "--plot", str(png)])
     assert code == 0 and png.read_bytes().startswith(PNG_SIGNATURE)
     assert "cost" in out
 
 
 def test_sequence_weights_change_the_cost(capsys):
-    equal = run_json(capsys, ["sequence", "paper_6x6_fig13a", "--solver", "exact", "--json"])
-    b_only = run_json(capsys, ["sequence", "paper_6x6_fig13a", "--solver", "exact", "--weights", "0,1,0,0", "--json"])
+    equal = run_json(capsys, ["sequence", "paper_6x6_fig13a", "--method", "exact", "--json"])
+    b_only = run_json(capsys, ["sequence", "paper_6x6_fig13a", "--method", "exact", "--weights", "0,1,0,0", "--json"])
     assert b_only["weights"] == [0, 1, 0, 0] and b_only["cost"] != pytest.approx(equal["cost"])
 
 
@@ -577,7 +584,7 @@ def test_sequence_bad_tileset_files_are_one_error_line(capsys, tmp_path):
 
 def test_sequence_exact_refuses_large_instances_clearly(capsys, tmp_path):
     big = scenario(tmp_path / "big.toml", grid="\n".join(["." * 16] * 12))
-    assert_one_error_line(*run(capsys, ["sequence", big, "--solver", "exact"]), "48", "40")
+    assert_one_error_line(*run(capsys, ["sequence", big, "--method", "exact"]), "48", "40")
 
 
 def test_console_script_output_into_a_closed_pipe_is_no_traceback():
@@ -587,3 +594,140 @@ def test_console_script_output_into_a_closed_pipe_is_no_traceback():
     err = proc.stderr.read().decode()
     assert proc.wait(timeout=60) == 1
     assert "Traceback" not in err and "BrokenPipeError" not in err
+
+
+# --------------------------------------------------------------------------------------------------
+# Output files: checked before the work, one error line, nothing half-written or left behind
+
+
+def _leftovers(folder: Path) -> list[str]:
+    return sorted(p.name for p in folder.iterdir())
+
+
+@pytest.mark.parametrize("where", ["missing folder", "onto a folder", "unwritable folder"])
+def test_tile_out_that_cannot_be_written_is_one_error_line(capsys, tmp_path, where):
+    if where == "missing folder":
+        target = tmp_path / "missing" / "x.txt"
+    elif where == "onto a folder":
+        target = tmp_path / "a_folder"
+        target.mkdir()
+    else:
+        if os.geteuid() == 0:
+            pytest.skip("root writes into read-only folders")  # CI runs as root: the other two cases still run
+        locked = tmp_path / "locked"
+        locked.mkdir(mode=0o500)
+        target = locked / "x.txt"
+    code, out, err = run(capsys, ["tile", "tiling_6x6", "--out", str(target)])
+    assert_one_error_line(code, out, err, "cannot write tileset", str(target))
+
+
+def test_unwritable_output_file_is_one_error_line_even_as_root(capsys, tmp_path):
+    # /proc/version exists and cannot be replaced, whoever runs the test
+    assert_one_error_line(*run(capsys, ["tile", "tiling_6x6", "--out", "/proc/version"]), "cannot write tileset")
+
+
+def test_a_bad_plot_path_fails_before_any_work_and_leaves_no_tileset(capsys, tmp_path):
+    ok = tmp_path / "ok.txt"
+    code, out, err = run(capsys, ["tile", "tiling_6x6", "--out", str(ok), "--plot", str(tmp_path / "nope" / "x.png")])
+    assert_one_error_line(code, out, err, "cannot write plot", "does not exist")
+    assert _leftovers(tmp_path) == []
+
+
+def test_plan_checks_the_plot_path_before_planning(capsys, near, tmp_path, monkeypatch):
+    import htetro_opt.cli as cli
+
+    def must_not_run(*args, **kwargs):
+        raise AssertionError("planned before checking the output path")
+
+    monkeypatch.setattr(cli, "plan_path", must_not_run)
+    code, out, err = run(capsys, ["plan", near, "--method", "htetro-ga", "--plot", str(tmp_path / "no" / "p.png")])
+    assert_one_error_line(code, out, err, "cannot write plot")
+
+
+@pytest.mark.parametrize("suffix,magic", [(".pdf", b"%PDF"), (".svg", b"<?xml"), (".png", PNG_SIGNATURE)])
+def test_plot_format_follows_the_extension(capsys, near, tmp_path, suffix, magic):
+    target = tmp_path / f"plan{suffix}"
+    assert main(["plan", near, "--plot", str(target)]) == 0
+    assert target.read_bytes().startswith(magic)
+
+
+def test_plot_with_an_unknown_extension_is_refused_before_work(capsys, near, tmp_path):
+    folder = tmp_path / "plots"
+    folder.mkdir()
+    assert_one_error_line(*run(capsys, ["plan", near, "--plot", str(folder / "x.docx")]), "docx", "pdf")
+    assert _leftovers(folder) == []
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["plan", "{near}", "--method", "htetro-ga", "--seed", "-1"], ["--seed", "-1"]),
+    (["sequence", "paper_6x6_fig13a", "--method", "ortools", "--time-limit", "1e300"], ["--time-limit", "1e+300"]),
+    (["sequence", "paper_6x6_fig13a", "--time-limit", "inf"], ["--time-limit", "inf"]),
+    (["tile", "tiling_6x6", "--time-limit", "0"], ["--time-limit"]),
+    (["tile", "tiling_6x6", "--shuffle", "--seed", "-3"], ["--seed", "-3"]),
+    (["plan", "{near}", "--method", "nsga2", "--pop-size", "1"], ["--pop-size", "1"]),
+])
+def test_bad_numbers_are_one_error_line(capsys, near, argv, words):
+    argv = [a.replace("{near}", near) for a in argv]
+    assert_one_error_line(*run(capsys, argv), *words)
+
+
+def test_plan_method_nsga2_runs_pymoos_nsga2(capsys, near):
+    out = run_json(capsys, ["plan", near, *GA_FAST[2:], "--method", "nsga2", "--seed", "1", "--json"])
+    assert out["method"] == "nsga2"
+
+
+def test_tile_shuffle_gives_reproducible_other_tilings(capsys):
+    fixed = run_json(capsys, ["tile", "tiling_10x10", "--json"])["tileset"]
+    assert run_json(capsys, ["tile", "tiling_10x10", "--json"])["tileset"] == fixed
+    assert_one_error_line(*run(capsys, ["tile", "tiling_10x10", "--seed", "5"]), "--seed", "--shuffle")
+    shuffled = {run_json(capsys, ["tile", "tiling_10x10", "--shuffle", "--seed", str(s), "--json"])["tileset"]
+                for s in range(4)}
+    assert run_json(capsys, ["tile", "tiling_10x10", "--shuffle", "--seed", "0", "--json"])["tileset"] in shuffled
+    assert len(shuffled | {fixed}) > 1
+
+
+@pytest.mark.parametrize("option", [["--pop-size", "20"], ["--seed", "3"], ["--max-gen", "5"], ["--patience", "5"],
+                                    ["--max-length", "30"]])
+def test_ga_options_with_an_exact_method_are_refused(capsys, near, option):
+    assert_one_error_line(*run(capsys, ["plan", near, "--method", "astar", *option]), option[0], "GA methods")
+
+
+def test_plan_help_shows_the_ga_defaults(capsys):
+    assert main(["plan", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    for default in ("(default 50)", "(default 1000)", "(default 100)", "(default 0)"):
+        assert default in text
+
+
+def test_a_ga_that_never_reaches_says_so_in_words(capsys, tmp_path):
+    # the goal lies in the other room: no individual ever reaches it
+    path = scenario(tmp_path / "apart.toml", grid=TWO_ROOMS, roadmap=pose(2, 2, "O") + pose(10, 2, "O"))
+    code, out, err = run(capsys, ["plan", path, "--method", "htetro-ga", "--pop-size", "8", "--max-gen", "3",
+                                  "--max-length", "10"])
+    assert code == 0, err
+    assert "goal first reached in no generation" in out and "None" not in out
+
+
+def _run_and_signal(argv, signum, *, after: float = 2.5):
+    import time as _time
+
+    exe = Path(sys.executable).parent / "htetro-opt"
+    proc = subprocess.Popen([str(exe), *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _time.sleep(after)
+    sent = _time.perf_counter()
+    proc.send_signal(signum)
+    out, err = proc.communicate(timeout=30)
+    return proc.returncode, out, err, _time.perf_counter() - sent
+
+
+@pytest.mark.parametrize("signame,code,word", [("SIGINT", 130, "interrupted"), ("SIGTERM", 143, "terminated")])
+def test_a_signal_ends_a_long_run_quietly_within_a_second(signame, code, word, tmp_path):
+    import signal as _signal
+
+    argv = ["plan", "three_slit", "--method", "htetro-ga", "--max-gen", "100000", "--patience", "100000",
+            "--plot", str(tmp_path / "never.png")]
+    returncode, out, err, took = _run_and_signal(argv, getattr(_signal, signame))
+    assert returncode == code, err
+    assert err.strip() == word and "Traceback" not in err
+    assert took < 1.5
+    assert list(tmp_path.iterdir()) == []  # no plot, no temporary file

@@ -1,5 +1,6 @@
 """The one hTetro robot model shared by every method (shared/MODEL.md): geometry, commands, sweeps,
-workspaces and the batch simulator. It imports nothing else of htetro_opt but its errors."""
+workspaces, the batch simulator and the coverage motion model. It imports nothing of htetro_opt
+above it (only its errors and option checks)."""
 
 from htetro_opt.model.commands import (
     COMMANDS,
@@ -14,6 +15,7 @@ from htetro_opt.model.commands import (
     format_commands,
     parse_commands,
 )
+from htetro_opt.model.coverage import CoverageResult, simulate_coverage
 from htetro_opt.model.robot import FOOTPRINTS, N_NAMED, N_STATES, SHAPES, STATE_NAMES, Pose, block_poses, shape_index
 from htetro_opt.model.simulate import SimulationResult, Simulator, simulate
 from htetro_opt.model.sweeps import SweepTables, sweep_tables
@@ -25,4 +27,5 @@ __all__ = [
     "FOOTPRINTS", "N_NAMED", "N_STATES", "SHAPES", "STATE_NAMES", "Pose", "block_poses", "shape_index",
     "SimulationResult", "Simulator", "simulate", "SweepTables", "sweep_tables",
     "MovingObstacle", "Workspace", "grid_distance",
+    "CoverageResult", "simulate_coverage",
 ]

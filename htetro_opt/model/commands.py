@@ -18,6 +18,7 @@ from typing import Iterable
 
 import numpy as np
 
+from htetro_opt._validation import check_real
 from htetro_opt.errors import ParameterError, UnknownCommandError
 from htetro_opt.model.robot import SHAPES
 
@@ -93,7 +94,7 @@ N_COMMANDS = len(COMMANDS)
 _TOKEN_INDEX = {token: i for i, token in enumerate(TOKENS)}
 
 SEED000_COMMANDS: tuple[str, ...] = ("x+", "x-", "y+", "y-", "r+", "r-") + tuple("s" + s for s in SHAPES)
-"""Seed 000's command set: the four translations, two rotations and seven shapeshifts."""
+"""Cheng et al. 2020's command set: the four translations, two rotations and seven shapeshifts."""
 DIAGONAL_COMMANDS: tuple[str, ...] = ("x+y+", "x+y-", "x-y+", "x-y-")
 """Seed 001's four diagonal translations."""
 SEED004_COMMANDS: tuple[str, ...] = (
@@ -121,9 +122,7 @@ class Timing:
 
     def __post_init__(self) -> None:
         for f in fields(self):
-            value = getattr(self, f.name)
-            if isinstance(value, bool) or not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
-                raise ParameterError(f"Timing.{f.name} must be a finite number >= 0, got {value!r}")
+            object.__setattr__(self, f.name, check_real(getattr(self, f.name), f"Timing.{f.name}", minimum=0.0))
 
     def durations(self) -> np.ndarray:
         """Duration of every command, indexed by command id."""
@@ -189,7 +188,7 @@ def format_commands(ids: Iterable[int]) -> list[str]:
 
 
 def command_set(*, diagonals: bool = False, seed004: bool = False, tokens: Iterable[str] | None = None) -> tuple[int, ...]:
-    """Ids of a command set: seed 000's by default, plus diagonals, or seed 004's, or explicit tokens.
+    """Ids of a command set: Cheng et al. 2020's by default, plus diagonals, or seed 004's, or given tokens.
 
     Repeated tokens count once.
 

@@ -8,7 +8,7 @@ stay in [π/2, 3π/2], so each relative turn is unambiguous.
 
 A *hinge state* is a triple of hinge angles in units of π/2, each 1, 2 or 3. The 23 triples whose
 blocks occupy four distinct cells are the robot's *states*; the first seven are the named
-morphologies of seed 000 Table 1 (I, O, L, J, Z, S, T), the rest are the intermediate states seed
+morphologies of Table 1 of Cheng et al. 2020 (I, O, L, J, Z, S, T), the rest are the intermediate states seed
 004's single-block commands pass through, named ``h`` + the triple (e.g. ``h213``).
 """
 
@@ -21,7 +21,8 @@ import numpy as np
 
 from typing import NamedTuple
 
-from htetro_opt.errors import ConfigurationError, UnknownShapeError
+from htetro_opt._validation import check_int
+from htetro_opt.errors import ConfigurationError, ParameterError, UnknownShapeError
 
 __all__ = [
     "Pose",
@@ -193,9 +194,10 @@ class Pose(NamedTuple):
         UnknownShapeError
             If the shape is not a state of the robot.
         """
-        for name, value in (("x", x), ("y", y), ("heading", heading)):
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-                raise ConfigurationError(f"pose {name} must be an integer, got {value!r}")
+        try:
+            x, y, heading = (check_int(v, f"pose {name}") for name, v in (("x", x), ("y", y), ("heading", heading)))
+        except ParameterError as err:  # a pose is a configuration: keep the error its callers catch
+            raise ConfigurationError(str(err)) from err
         if not 0 <= heading < N_HEADINGS:
             raise ConfigurationError(f"pose heading must be 0, 1, 2 or 3 (quarter turns), got {heading}")
         shape_index(shape)

@@ -22,7 +22,8 @@ from typing import Iterable, Sequence
 
 import numpy as np
 
-from htetro_opt.errors import ConfigurationError, UnknownCommandError
+from htetro_opt._validation import check_int
+from htetro_opt.errors import ConfigurationError, ParameterError, UnknownCommandError
 from htetro_opt.model.commands import (
     COMMANDS,
     N_COMMANDS,
@@ -109,8 +110,8 @@ class Simulator:
     ----------
     workspace : Workspace
     commands : iterable of str or int, optional, keyword-only
-        Command tokens or ids the sequences may use; seed 000's set by default (plus the diagonals
-        when ``diagonals``). Seed 004's block commands bring in the 16 intermediate states.
+        Command tokens or ids the sequences may use; Cheng et al. 2020's set by default (plus the
+        diagonals when ``diagonals``). Seed 004's block commands bring in the 16 intermediate states.
     diagonals : bool, keyword-only
         Add the four diagonal translations to the default set.
     timing : Timing, keyword-only
@@ -144,9 +145,10 @@ class Simulator:
             if all(isinstance(c, str) for c in listed):
                 ids = command_set(tokens=listed)
             else:
-                bad = [c for c in listed if isinstance(c, bool) or not isinstance(c, (int, np.integer)) or not 0 <= c < N_COMMANDS]
-                if bad:
-                    raise UnknownCommandError(f"command set holds {bad[0]!r}: neither a token nor a command id")
+                try:
+                    listed = [check_int(c, "command id", minimum=0, maximum=N_COMMANDS - 1) for c in listed]
+                except ParameterError as err:
+                    raise UnknownCommandError(f"a command set is all tokens or all command ids: {err}") from err
                 ids = command_set(tokens=[TOKENS[c] for c in listed])
         self.workspace = workspace
         self.timing = timing if timing is not None else Timing()
@@ -346,7 +348,7 @@ class Simulator:
         t0 : int, keyword-only
             Time index (commands already executed) at the start, for moving obstacles.
         stop_at_goal : bool, keyword-only
-            End each sequence when it reaches the goal (seed 000's child termination).
+            End each sequence when it reaches the goal (Cheng et al. 2020's child termination).
         repair : numpy.random.Generator, optional, keyword-only
             Replace every command that would be invalid where it is executed by one drawn uniformly
             from the commands valid there (a sequence dies only where none is); the result's
@@ -366,23 +368,28 @@ class Simulator:
         start_id = start if isinstance(start, (int, np.integer)) else self.check_pose(start, what="start", t=t0)
         goals = np.array([self.encode(p) for p in roadmap], dtype=np.int64) if roadmap else np.empty(0, np.int64)
         local, lengths = self._local_commands(sequences)
-        if repair is None:
-            keys = self._step_all(local, lengths, start_id * self.n_columns, t0)
-        else:
-            keys, local = self._step_all_repairing(local, lengths, start_id * self.n_columns, t0, repair)
+        keys, local = self._step_all(local, lengths, start_id * self.n_columns, t0, repair)
         return self._summarise(keys, local, lengths, goals * self.n_columns, stop_at_goal)
 
-    def _step_all(self, local: np.ndarray, lengths: np.ndarray, start_key: int, t0: int) -> np.ndarray:
-        """Keys ``pose * n_columns`` after each step, shape (L + 1, B): the hot loop."""
+    def _step_all(self, local: np.ndarray, lengths: np.ndarray, start_key: int, t0: int,
+                  repair: np.random.Generator | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The hot loop: keys ``pose * n_columns`` after each step, shape (L + 1, B), and the (B, L)
+        local commands as run (``local`` itself unless ``repair`` changed some).
+
+        Each step is one add and one gather for the whole batch; moving obstacles add one
+        ``searchsorted``. With ``repair``, a command that kills a live sequence is replaced by a valid
+        one (:meth:`_repair_step`); padding never dies, so it is never repaired.
+        """
         batch, width = local.shape
         flat = self._flat_next
         dead_key = self.dead * self.n_columns
-        steps = np.ascontiguousarray(local.T, dtype=flat.dtype)  # (L, B): one contiguous row per step
+        steps = np.array(local.T, dtype=flat.dtype, order="C")  # (L, B): a contiguous row per step, a copy repair may change
         keys = np.empty((width + 1, batch), dtype=flat.dtype)
         keys[0] = start_key
         index = np.empty(batch, dtype=flat.dtype)
         add, take = np.add, flat.take
         moving = bool(self.workspace.moving)
+        blocked = None
         for t in range(width):
             if t % 8 == 0 and t and not ((keys[t] != dead_key) & (lengths > t)).any():
                 keys[t + 1 :] = keys[t]  # every sequence has died or ended: nothing changes any more
@@ -394,7 +401,11 @@ class Simulator:
                 if len(blocked):
                     at = np.searchsorted(blocked, index).clip(max=len(blocked) - 1)
                     keys[t + 1][blocked[at] == index] = dead_key
-        return keys
+            if repair is not None:
+                self._repair_step(t, steps, keys, blocked, repair)
+        if repair is None:
+            return keys, local
+        return keys, steps.T.astype(np.int64)
 
     @cached_property
     def _valid_columns(self) -> tuple[np.ndarray, np.ndarray]:
@@ -403,49 +414,31 @@ class Simulator:
         order = np.argsort(~valid, axis=1, kind="stable").astype(np.int16)
         return order, valid.sum(axis=1)
 
-    def _step_all_repairing(self, local, lengths, start_key, t0, rng) -> tuple[np.ndarray, np.ndarray]:
-        """As :meth:`_step_all`, replacing each invalid command by a random valid one; also returns
-        the repaired (B, L) local commands. (Padding never dies, so it is never repaired.)"""
-        batch, width = local.shape
+    def _repair_step(self, t: int, steps: np.ndarray, keys: np.ndarray, blocked: np.ndarray | None,
+                     rng: np.random.Generator) -> None:
+        """Replace, in place, step t's commands that killed a live sequence by one drawn uniformly
+        from the commands valid there, and redo their step; a sequence dies only where none is."""
         flat = self._flat_next
         dead_key = self.dead * self.n_columns
-        columns = self.n_columns
-        steps = np.array(local.T, dtype=flat.dtype, order="C")
-        keys = np.empty((width + 1, batch), dtype=flat.dtype)
-        keys[0] = start_key
-        index = np.empty(batch, dtype=flat.dtype)
-        order, count = self._valid_columns
-        all_columns = np.arange(self.n_commands, dtype=flat.dtype)
-        moving = bool(self.workspace.moving)
-        for t in range(width):
-            if t % 8 == 0 and t and not (keys[t] != dead_key).any():
-                keys[t + 1 :] = keys[t]
-                break
-            np.add(keys[t], steps[t], out=index)
-            flat.take(index, out=keys[t + 1])
-            blocked = self.blocked_keys(t0 + t) if moving else None
-            if blocked is not None and len(blocked):
-                at = np.searchsorted(blocked, index).clip(max=len(blocked) - 1)
-                keys[t + 1][blocked[at] == index] = dead_key
-            bad = np.flatnonzero((keys[t + 1] == dead_key) & (keys[t] != dead_key))
-            if not len(bad):
-                continue
-            here = keys[t][bad]
-            if blocked is None or not len(blocked):
-                n_valid = count[here // columns]
-                bad, here, n_valid = bad[n_valid > 0], here[n_valid > 0], n_valid[n_valid > 0]
-                pick = order[here // columns, (rng.random(len(bad)) * n_valid).astype(np.int64)].astype(flat.dtype)
-            else:  # the static table does not know the moving obstacles: test every command
-                candidates = here[:, None] + all_columns[None, :]
-                ok = flat[candidates] != dead_key
-                at = np.searchsorted(blocked, candidates).clip(max=len(blocked) - 1)
-                ok &= blocked[at] != candidates
-                pick = np.where(ok, rng.random(ok.shape), -1.0).argmax(axis=1).astype(flat.dtype)
-                fixable = ok.any(axis=1)
-                bad, here, pick = bad[fixable], here[fixable], pick[fixable]
-            steps[t, bad] = pick
-            keys[t + 1, bad] = flat[here + pick]
-        return keys, steps.T.astype(np.int64)
+        bad = np.flatnonzero((keys[t + 1] == dead_key) & (keys[t] != dead_key))
+        if not len(bad):
+            return
+        here = keys[t][bad]
+        if blocked is None or not len(blocked):
+            n_valid = self._valid_columns[1][here // self.n_columns]
+            bad, here, n_valid = bad[n_valid > 0], here[n_valid > 0], n_valid[n_valid > 0]
+            draw = (rng.random(len(bad)) * n_valid).astype(np.int64)
+            pick = self._valid_columns[0][here // self.n_columns, draw].astype(flat.dtype)
+        else:  # the static table does not know the moving obstacles: test every command
+            candidates = here[:, None] + np.arange(self.n_commands, dtype=flat.dtype)[None, :]
+            ok = flat[candidates] != dead_key
+            at = np.searchsorted(blocked, candidates).clip(max=len(blocked) - 1)
+            ok &= blocked[at] != candidates
+            pick = np.where(ok, rng.random(ok.shape), -1.0).argmax(axis=1).astype(flat.dtype)
+            fixable = ok.any(axis=1)
+            bad, here, pick = bad[fixable], here[fixable], pick[fixable]
+        steps[t, bad] = pick
+        keys[t + 1, bad] = flat[here + pick]
 
     def _summarise(self, keys, local, lengths, goal_keys, stop_at_goal) -> SimulationResult:
         """Per-sequence outcome from the (L + 1, B) keys of a run."""

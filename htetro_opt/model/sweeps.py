@@ -23,7 +23,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from htetro_opt.errors import ParameterError
+from htetro_opt._validation import check_real
 from htetro_opt.model.commands import COMMANDS, N_COMMANDS, Command
 from htetro_opt.model.robot import HINGE_STATES, N_HEADINGS, N_STATES, block_poses, rotate_cells
 
@@ -185,9 +185,7 @@ def sweep_tables(clearance: float = 0.0) -> SweepTables:
     >>> int(tables.counts[0, 0, 8])  # the I-shape turning by +90°
     16
     """
-    if isinstance(clearance, bool) or not (isinstance(clearance, (int, float)) and math.isfinite(clearance) and clearance >= 0):
-        raise ParameterError(f"clearance must be a finite number >= 0 (cells), got {clearance!r}")
-    return _sweep_tables(float(clearance))
+    return _sweep_tables(check_real(clearance, "clearance (cells)", minimum=0.0))
 
 
 @lru_cache(maxsize=8)

@@ -14,7 +14,8 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from htetro_opt.errors import ConfigurationError, ScenarioError
+from htetro_opt._validation import check_int, check_real
+from htetro_opt.errors import ConfigurationError, ParameterError, ScenarioError
 
 __all__ = ["Workspace", "MovingObstacle", "grid_distance"]
 
@@ -50,8 +51,10 @@ class MovingObstacle:
             raise ScenarioError("a moving obstacle needs at least one cell")
         if len(route) == 0 or route[0].any():
             route = np.vstack([np.zeros((1, 2), dtype=np.int64), route])
-        if not (isinstance(self.speed, int) and self.speed >= 1):
-            raise ScenarioError(f"moving obstacle speed must be an integer >= 1, got {self.speed!r}")
+        try:
+            speed = check_int(self.speed, "moving obstacle speed", minimum=1)
+        except ParameterError as err:  # obstacles come from scenario files: the loader's error
+            raise ScenarioError(str(err)) from err
         if self.mode not in ("pingpong", "loop"):
             raise ScenarioError(f"moving obstacle mode must be 'pingpong' or 'loop', got {self.mode!r}")
         path = [route[0]]
@@ -66,6 +69,7 @@ class MovingObstacle:
             unit = unit[:-1]
         object.__setattr__(self, "cells", cells)
         object.__setattr__(self, "route", route)
+        object.__setattr__(self, "speed", speed)
         object.__setattr__(self, "_steps", unit)
 
     @property
@@ -117,8 +121,11 @@ class Workspace:
         occ = np.array(self.occupancy, dtype=bool)
         if occ.ndim != 2 or occ.shape[0] == 0 or occ.shape[1] == 0:
             raise ScenarioError(f"occupancy must be a non-empty 2-D array, got shape {occ.shape}")
-        if not (math.isfinite(self.cell_size) and self.cell_size > 0):
-            raise ScenarioError(f"cell_size must be a positive number, got {self.cell_size!r}")
+        try:
+            cell_size = check_real(self.cell_size, "cell_size", minimum=0.0, include_minimum=False)
+        except ParameterError as err:  # maps come from scenario files: the loader's error
+            raise ScenarioError(str(err)) from err
+        object.__setattr__(self, "cell_size", cell_size)
         occ.setflags(write=False)
         object.__setattr__(self, "occupancy", occ)
         object.__setattr__(self, "moving", tuple(self.moving))

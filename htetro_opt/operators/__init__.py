@@ -1,33 +1,16 @@
-"""pymoo operators over variable-length motion-command chromosomes (seed 000).
+"""Variation and selection operators, one family per kind of chromosome.
 
-One operator per module, each a pure function over ``numpy`` arrays beside a thin pymoo class that
-takes the ``random_state`` pymoo passes:
+- :mod:`htetro_opt.operators.commands` (Cheng et al. 2020): pymoo operators over variable-length
+  motion-command chromosomes, each a pure batch function beside a thin pymoo class;
+- :mod:`htetro_opt.operators.permutation` (Le et al. 2018): DEAP operators over waypoint orders,
+  drawing from a private ``random.Random``.
 
-- :mod:`.sampling`: Algorithm 1 (:class:`CommandSampling`);
-- :mod:`.mutation`: per-command mutation (:class:`CommandMutation`);
-- :mod:`.crossover`: single-point crossover of variable-length parents (:class:`CommandCrossover`);
-- :mod:`.removal` and :mod:`.rearrangement`: the conservative operators, which never change B2's
-  total displacement (:class:`CommandRemoval`, :class:`CommandRearrangement`);
-- :mod:`.repair`: ours, optional: invalid commands replaced by valid ones (:class:`CommandRepair`);
-- :mod:`.shortcut`: ours, optional: cut the longest loop of a path (:class:`CommandShortcut`);
-- :mod:`.duplicates`: :class:`CommandDuplicateElimination`;
-- :mod:`.selection`: the size-4 deterministic tournament on rank and crowding;
-- :mod:`.survival`: the goal-reachability sort (:class:`GoalReachabilitySurvival`).
+Every public name of both is available here too.
 """
 
-from htetro_opt.operators._chromosome import as_column, displacement, sequences
-from htetro_opt.operators.crossover import CommandCrossover, single_point_crossover
-from htetro_opt.operators.duplicates import CommandDuplicateElimination, chromosome_key
-from htetro_opt.operators.mutation import CommandMutation, mutate_commands
-from htetro_opt.operators.rearrangement import CommandRearrangement, rearrange_commands
-from htetro_opt.operators.repair import CommandRepair
-from htetro_opt.operators.removal import CommandRemoval, remove_commands
-from htetro_opt.operators.shortcut import CommandShortcut, cut_longest_loop, longest_loops, shortcut_sequences
-from htetro_opt.operators.sampling import DEFAULT_WEIGHTS, CommandSampling, sample_commands
-from htetro_opt.operators.selection import RankAndCrowdingTournament, rank_and_crowding_tournament
-from htetro_opt.operators.survival import GoalReachabilitySurvival, reaches_goal
+from htetro_opt._lazy import attach
 
-__all__ = [
+_COMMANDS = [
     "as_column", "displacement", "sequences",
     "CommandCrossover", "single_point_crossover",
     "CommandDuplicateElimination", "chromosome_key",
@@ -35,8 +18,12 @@ __all__ = [
     "CommandRearrangement", "rearrange_commands",
     "CommandRemoval", "remove_commands",
     "CommandRepair",
-    "CommandShortcut", "cut_longest_loop", "longest_loops", "shortcut_sequences",
-    "DEFAULT_WEIGHTS", "CommandSampling", "sample_commands",
+    "CommandShortcut", "cut_longest_loop", "longest_loops", "shortcut_sequences", "repair_and_shortcut",
+    "DEFAULT_SAMPLING_WEIGHTS", "CommandSampling", "sample_commands",
     "RankAndCrowdingTournament", "rank_and_crowding_tournament",
     "GoalReachabilitySurvival", "reaches_goal",
 ]
+_PERMUTATION = ["Tour", "TourFitness", "order_crossover", "select_tournament", "swap_mutation"]
+
+__getattr__, __dir__, __all__ = attach(__name__, {**{name: ".commands" for name in _COMMANDS},
+                                                  **{name: ".permutation" for name in _PERMUTATION}})

@@ -1,30 +1,21 @@
 """Formal problem definitions, one module per paper, on the shared model.
 
-- :mod:`~htetro_opt.problems.command_path` (seed 000): variable-length motion-command chromosomes
-  with the four fitnesses of eqs. 3–6, as a pymoo problem.
-- :mod:`~htetro_opt.problems.waypoint_sequencing` (seed 003): tile waypoints (Algorithm 1), the
-  eq.-2 block-displacement cost and the open-path TSP over them, for every sequencing solver.
+- :mod:`~htetro_opt.problems.command_path` (Cheng et al. 2020): variable-length motion-command
+  chromosomes with the four fitnesses of eqs. 3–6, as a pymoo problem;
+- :mod:`~htetro_opt.problems.waypoint_sequencing` (Le et al. 2018): tile waypoints (Algorithm 1), the
+  eq.-2 block-displacement cost and the open-path TSP over them, for every sequencing method, plus
+  :class:`SequencingProblem`, the same as a pymoo permutation problem.
+
+Names load lazily, so that importing the sequencing problem does not import pymoo.
 """
 
-from htetro_opt.problems.command_path import (
-    FITNESS_NAMES,
-    SAFETY_COEFFICIENT,
-    SAFETY_PATTERN,
-    CommandPathProblem,
-    safety_field,
-)
-from htetro_opt.problems.waypoint_sequencing import (
-    DEFAULT_WEIGHTS,
-    SequencingInstance,
-    SequencingProblem,
-    block_locations,
-    check_weights,
-    cost_matrix,
-    path_cost,
-)
+from htetro_opt._lazy import attach
 
-__all__ = [
-    "CommandPathProblem", "FITNESS_NAMES", "SAFETY_COEFFICIENT", "SAFETY_PATTERN", "safety_field",
-    "DEFAULT_WEIGHTS", "SequencingInstance", "SequencingProblem", "block_locations", "check_weights",
-    "cost_matrix", "path_cost",
-]
+__getattr__, __dir__, __all__ = attach(__name__, {
+    **{name: ".command_path" for name in
+       ("CommandPathProblem", "FITNESS_NAMES", "SAFETY_COEFFICIENT", "SAFETY_PATTERN", "safety_field")},
+    **{name: ".waypoint_sequencing" for name in
+       ("DEFAULT_BLOCK_WEIGHTS", "SequencingInstance", "block_locations", "check_weights", "cost_matrix",
+        "path_cost")},
+    "SequencingProblem": "._sequencing_problem",
+})

@@ -1,4 +1,4 @@
-"""Seed 000's path planning as a pymoo problem: variable-length motion-command chromosomes.
+"""Cheng et al. 2020's path planning as a pymoo problem: variable-length motion-command chromosomes.
 
 An individual is one object variable holding an integer array of global command ids (see
 :func:`~htetro_opt.model.parse_commands`). A population is evaluated as one batch by the shared
@@ -29,9 +29,9 @@ from typing import Sequence
 import numpy as np
 from pymoo.core.problem import Problem
 
-from htetro_opt.errors import ParameterError
+from htetro_opt._validation import check_int
 from htetro_opt.model.commands import SEED000_COMMANDS, Timing
-from htetro_opt.model.robot import FOOTPRINTS, N_HEADINGS, Pose
+from htetro_opt.model.robot import FOOTPRINTS, Pose
 from htetro_opt.model.simulate import SimulationResult, Simulator
 from htetro_opt.model.workspace import Workspace, grid_distance
 
@@ -86,7 +86,7 @@ def safety_field(occupancy: np.ndarray) -> np.ndarray:
 
 
 class CommandPathProblem(Problem):
-    """Seed 000's four-objective path problem from one configuration to the next.
+    """Cheng et al. 2020's four-objective path problem from one configuration to the next.
 
     Parameters
     ----------
@@ -101,7 +101,7 @@ class CommandPathProblem(Problem):
     t0 : int, keyword-only
         Commands executed before this leg (the clock of moving obstacles).
     commands : sequence of str, optional, keyword-only
-        The command alphabet (default: seed 000's thirteen commands).
+        The command alphabet (default: Cheng et al. 2020's thirteen commands).
     timing : Timing, optional, keyword-only
     clearance : float, keyword-only
         δ in cells (MODEL.md §4).
@@ -145,10 +145,8 @@ class CommandPathProblem(Problem):
         timing: Timing | None = None,
         clearance: float = 0.0,
     ) -> None:
-        if isinstance(max_length, bool) or not isinstance(max_length, (int, np.integer)) or max_length < 1:
-            raise ParameterError(f"max_length (l_p,max) must be a positive integer, got {max_length!r}")
-        if isinstance(t0, bool) or not isinstance(t0, (int, np.integer)) or t0 < 0:
-            raise ParameterError(f"t0 must be a non-negative integer, got {t0!r}")
+        max_length = check_int(max_length, "max_length (l_p,max)", minimum=1)
+        t0 = check_int(t0, "t0", minimum=0)
         if isinstance(workspace, Simulator):
             sim = workspace
         else:
@@ -157,10 +155,10 @@ class CommandPathProblem(Problem):
         self.simulator = sim
         self.start = Pose.of(*start)
         self.goal = Pose.of(*goal)
-        self.t0 = int(t0)
+        self.t0 = t0
         self.start_id = sim.check_pose(self.start, what="start", t=self.t0)
         self.goal_id = sim.check_pose(self.goal, what="goal")
-        self.max_length = int(max_length)
+        self.max_length = max_length
         self.command_ids = sim.command_ids.copy()
         self.durations = sim.timing.durations()
         self.t_max = self.max_length * sim.timing.translation
@@ -181,7 +179,6 @@ class CommandPathProblem(Problem):
         bx = blocks[..., 0].clip(0, ws.width - 1)
         by = blocks[..., 1].clip(0, ws.height - 1)
         danger = np.append(danger_field[by, bx].sum(axis=1), 0.0)
-        assert N_HEADINGS == FOOTPRINTS.shape[1]
         return reachability, danger
 
     # --- evaluation --------------------------------------------------------------------------

@@ -1,4 +1,4 @@
-"""Seed 003's waypoint sequencing: tiles become waypoints, and their order is an open-path TSP.
+"""Waypoint sequencing (Le et al. 2018): tiles become waypoints, and their order is an open-path TSP.
 
 - **Block locations** (Algorithm 1): tiles are visited in scan order (top row first, left to right);
   a tile with one filling pose (L, J, T) takes it, a symmetric tile (I, S, Z: 2 options, O: 4) takes
@@ -10,7 +10,7 @@
 - **Sequencing** (eq. 4): the order visiting every waypoint once, from a start tile (tile 1 by
   default, or free), that minimises the summed cost. The path is open: it does not return.
 
-:class:`SequencingInstance` holds one instance for every solver (cost matrix, block cells, start);
+:class:`SequencingInstance` holds one instance for every sequencing method (cost matrix, block cells, start);
 :class:`SequencingProblem` poses it as a pymoo permutation problem.
 """
 
@@ -19,23 +19,22 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from pymoo.core.problem import Problem
 
+from htetro_opt._validation import check_int
 from htetro_opt.errors import ParameterError, PlanningError
 from htetro_opt.model.tiles import scan_key, tile_poses
 from htetro_opt.scenarios.tileset import Tileset
 
 __all__ = [
-    "DEFAULT_WEIGHTS",
+    "DEFAULT_BLOCK_WEIGHTS",
     "check_weights",
     "block_locations",
     "cost_matrix",
     "path_cost",
     "SequencingInstance",
-    "SequencingProblem",
 ]
 
-DEFAULT_WEIGHTS = (0.25, 0.25, 0.25, 0.25)
+DEFAULT_BLOCK_WEIGHTS = (0.25, 0.25, 0.25, 0.25)
 """α, β, λ, γ of eq. 2: every block counts the same."""
 
 
@@ -64,7 +63,7 @@ def check_weights(weights) -> np.ndarray:
     return w
 
 
-def cost_matrix(blocks, weights=DEFAULT_WEIGHTS) -> np.ndarray:
+def cost_matrix(blocks, weights=DEFAULT_BLOCK_WEIGHTS) -> np.ndarray:
     """Eq. 2 between every pair of waypoints: ``C[i, j] = Σ_l w_l ‖blocks[i, l] − blocks[j, l]‖``.
 
     Parameters
@@ -104,7 +103,8 @@ def path_cost(cost: np.ndarray, order) -> np.ndarray | float:
     return float(legs) if order.ndim == 1 else legs
 
 
-def block_locations(occupancy, tiles, *, weights=DEFAULT_WEIGHTS, cell_size: float = 1.0, name: str = "") -> Tileset:
+def block_locations(occupancy, tiles, *, weights=DEFAULT_BLOCK_WEIGHTS, cell_size: float = 1.0,
+                    name: str = "") -> Tileset:
     """Algorithm 1: label the blocks of every tile and number the tiles in scan order.
 
     Parameters
@@ -152,7 +152,7 @@ def block_locations(occupancy, tiles, *, weights=DEFAULT_WEIGHTS, cell_size: flo
 
 @dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
 class SequencingInstance:
-    """One waypoint-sequencing instance, shared by every solver.
+    """One waypoint-sequencing instance, shared by every sequencing method.
 
     Parameters
     ----------
@@ -166,6 +166,13 @@ class SequencingInstance:
         Tile labels, for reporting orders.
     shape : (int, int)
         The grid's (H, W).
+
+    Raises
+    ------
+    PlanningError
+        If the cost matrix is not square, non-empty and finite.
+    ParameterError
+        If ``start`` is not None or a waypoint index.
     """
 
     cost: np.ndarray
@@ -179,8 +186,7 @@ class SequencingInstance:
         n = len(cost)
         if cost.shape != (n, n) or n == 0 or not np.isfinite(cost).all():
             raise PlanningError(f"the cost matrix must be square, non-empty and finite, got shape {cost.shape}")
-        if self.start is not None and not 0 <= self.start < n:
-            raise PlanningError(f"start waypoint index {self.start} is outside 0…{n - 1}")
+        start = check_int(self.start, "start", minimum=0, maximum=n - 1, allow_none=True)
         blocks = np.array(self.blocks, dtype=np.int64).reshape(n, 4, 2)
         ids = tuple(self.ids) or tuple(range(1, n + 1))
         for array in (cost, blocks):
@@ -188,9 +194,11 @@ class SequencingInstance:
         object.__setattr__(self, "cost", cost)
         object.__setattr__(self, "blocks", blocks)
         object.__setattr__(self, "ids", ids)
+        object.__setattr__(self, "start", start)
 
     @classmethod
-    def from_tileset(cls, tileset: Tileset, *, start: int | None = 1, weights=DEFAULT_WEIGHTS) -> "SequencingInstance":
+    def from_tileset(cls, tileset: Tileset, *, start: int | None = 1,
+                     weights=DEFAULT_BLOCK_WEIGHTS) -> "SequencingInstance":
         """The instance of a labelled tileset.
 
         Parameters
@@ -246,35 +254,11 @@ class SequencingInstance:
         return [self.ids[i] for i in np.asarray(order, dtype=np.int64).tolist()]
 
 
-class SequencingProblem(Problem):
-    """The sequencing instance as a pymoo permutation problem, so pymoo's GAs can run on it.
+def __getattr__(name: str):
+    # SequencingProblem subclasses pymoo's Problem; it lives apart so that tiling and sequencing,
+    # which import this module, do not import pymoo.
+    if name == "SequencingProblem":
+        from htetro_opt.problems._sequencing_problem import SequencingProblem
 
-    With a fixed start the variables are a permutation of the other ``n − 1`` waypoints (use pymoo's
-    ``PermutationRandomSampling``, ``OrderCrossover``, ``InversionMutation``); :meth:`order` turns a
-    solution into the full order. One objective, the path cost.
-
-    Examples
-    --------
-    >>> from htetro_opt.scenarios import parse_tileset
-    >>> inst = SequencingInstance.from_tileset(parse_tileset("1a 1b 1c 1d\\n2a 2b 2c 2d\\n3a 3b 3c 3d"))
-    >>> problem = SequencingProblem(inst)
-    >>> problem.n_var, problem.evaluate(np.array([[0, 1], [1, 0]]))[:, 0].tolist()
-    (2, [2.0, 3.0])
-    """
-
-    def __init__(self, instance: SequencingInstance):
-        self.instance = instance
-        self._free = np.array([i for i in range(instance.n) if i != instance.start], dtype=np.int64)
-        super().__init__(n_var=len(self._free), n_obj=1, xl=0, xu=max(len(self._free) - 1, 0), vtype=int)
-
-    def order(self, x) -> np.ndarray:
-        """Full waypoint order(s) of solution(s) ``x``."""
-        x = np.asarray(x, dtype=np.int64)
-        rest = self._free[x]
-        if self.instance.start is None:
-            return rest
-        head = np.full(rest.shape[:-1] + (1,), self.instance.start, dtype=np.int64)
-        return np.concatenate([head, rest], axis=-1)
-
-    def _evaluate(self, x, out, *args, **kwargs):
-        out["F"] = np.atleast_1d(path_cost(self.instance.cost, self.order(x))).reshape(-1, 1)
+        return SequencingProblem
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

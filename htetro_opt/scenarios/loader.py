@@ -31,7 +31,6 @@ A continuous scenario (seed 002) has ``width``, ``height``, ``obstacles`` (recta
 
 from __future__ import annotations
 
-import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -39,7 +38,8 @@ from typing import Any
 
 import numpy as np
 
-from htetro_opt.errors import ConfigurationError, MapFormatError, ScenarioError, UnknownShapeError
+from htetro_opt._validation import check_real
+from htetro_opt.errors import ConfigurationError, MapFormatError, ParameterError, ScenarioError, UnknownShapeError
 from htetro_opt.model.robot import Pose, shape_index
 from htetro_opt.model.workspace import MovingObstacle, Workspace
 from htetro_opt.scenarios.rosmap import load_ros_map
@@ -142,17 +142,23 @@ def _require(table: dict, key: str, kinds, where: str):
     return value
 
 
-def _header(data: dict, allowed: set[str], where: str) -> tuple[str, str, str]:
-    """Check a scenario's keys; its name, source and description."""
+def _header(data: dict, allowed: set[str], where: str, default_name: str | None) -> tuple[str, str, str]:
+    """Check a scenario's keys; its name (``default_name``, the file's stem, when absent), source and
+    description (both optional: a user's own map needs no bookkeeping)."""
     unknown = set(data) - allowed
     if unknown:
         raise ScenarioError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
-    name = _require(data, "name", str, where)
-    source = _require(data, "source", str, where)
-    description = data.get("description", "")
-    if not isinstance(description, str):
-        raise ScenarioError(f"{where}: 'description' must be a string")
-    return name, source, description
+    if "name" in data or default_name is None:
+        name = _require(data, "name", str, where)
+    else:
+        name = default_name
+    texts = []
+    for key in ("source", "description"):
+        value = data.get(key, "")
+        if not isinstance(value, str):
+            raise ScenarioError(f"{where}: {key!r} must be a string, got {type(value).__name__}")
+        texts.append(value)
+    return name, texts[0], texts[1]
 
 
 def _array(data: dict, key: str, where: str, *, tables: bool = False) -> list:
@@ -163,13 +169,15 @@ def _array(data: dict, key: str, where: str, *, tables: bool = False) -> list:
     return value
 
 
-def _number(table: dict, key: str, where: str, default=None) -> float:
+def _number(table: dict, key: str, where: str, default=None, **bounds) -> float:
+    """A finite number (within :func:`~htetro_opt._validation.check_real`'s ``bounds``) from a TOML table."""
     value = table.get(key, default)
     if value is None:
         raise ScenarioError(f"{where}: missing key {key!r}")
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ScenarioError(f"{where}: {key!r} must be a number, got {value!r}")
-    return float(value)
+    try:
+        return check_real(value, f"{where}: {key!r}", **bounds)
+    except ParameterError as err:  # a file's content: the loader's error
+        raise ScenarioError(str(err)) from err
 
 
 def _point_in_obstacle(point: np.ndarray, polygon: np.ndarray, radius: float) -> bool:
@@ -240,8 +248,12 @@ def _check_pose_on_map(pose: Pose, workspace: Workspace, where: str, t: int | No
         )
 
 
-def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = None) -> Scenario | ContinuousScenario:
+def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = None,
+                   default_name: str | None = None) -> Scenario | ContinuousScenario:
     """Build a scenario from a parsed TOML table (see the module docstring for the format).
+
+    ``name`` may be left out when ``default_name`` is given (a file's stem); ``source`` and
+    ``description`` are optional.
 
     Raises
     ------
@@ -253,13 +265,15 @@ def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = N
         If a roadmap configuration names an unknown shape.
     """
     if "grid" not in data and "map" not in data and ("width" in data or "robots" in data):
-        return _parse_continuous(data, where=where, base=base)
-    name, source, description = _header(data, _GRID_KEYS, where)
+        return _parse_continuous(data, where=where, base=base, default_name=default_name)
+    name, source, description = _header(data, _GRID_KEYS, where, default_name)
     if ("grid" in data) == ("map" in data):
         raise ScenarioError(f"{where}: give exactly one of 'grid' (text rows) or 'map' (a ROS map YAML)")
-    cell_size = data.get("cell_size_m")
-    if cell_size is not None and (isinstance(cell_size, bool) or not isinstance(cell_size, (int, float)) or not cell_size > 0):
-        raise ScenarioError(f"{where}: 'cell_size_m' must be a positive number")
+    try:
+        cell_size = check_real(data.get("cell_size_m"), f"{where}: 'cell_size_m'", minimum=0.0, include_minimum=False,
+                               allow_none=True)
+    except ParameterError as err:  # a file's content: the loader's error
+        raise ScenarioError(str(err)) from err
     if "grid" in data:
         occ = parse_grid(_require(data, "grid", str, where), where=f"{where}: grid")
         cell_size = float(cell_size) if cell_size is not None else 1.0
@@ -304,13 +318,11 @@ def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = N
     return Scenario(name, source, workspace, tuple(roadmap), description, hidden, base)
 
 
-def _parse_continuous(data: dict, *, where: str, base: Path | None) -> ContinuousScenario:
-    name, source, description = _header(data, _CONTINUOUS_KEYS, where)
-    width = _number(data, "width", where)
-    height = _number(data, "height", where)
-    radius = _number(data, "robot_radius", where, default=0.0)
-    if not (width > 0 and height > 0 and radius >= 0):
-        raise ScenarioError(f"{where}: width and height must be positive and robot_radius >= 0")
+def _parse_continuous(data: dict, *, where: str, base: Path | None, default_name: str | None = None) -> ContinuousScenario:
+    name, source, description = _header(data, _CONTINUOUS_KEYS, where, default_name)
+    width = _number(data, "width", where, minimum=0.0, include_minimum=False)
+    height = _number(data, "height", where, minimum=0.0, include_minimum=False)
+    radius = _number(data, "robot_radius", where, default=0.0, minimum=0.0)
     obstacles = []
     for i, item in enumerate(_array(data, "obstacles", where), start=1):
         at = f"{where}: obstacles[{i}]"
@@ -367,7 +379,7 @@ def load_scenario_file(path: str | Path) -> Scenario | ContinuousScenario:
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark, as some editors write, is fine
     except OSError as err:
         raise ScenarioError(f"{path}: cannot read scenario: {err.strerror or err}") from err
     except UnicodeDecodeError as err:
@@ -376,4 +388,4 @@ def load_scenario_file(path: str | Path) -> Scenario | ContinuousScenario:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise ScenarioError(f"{path}: malformed TOML: {' '.join(str(err).split())}") from err
-    return parse_scenario(data, where=str(path.name), base=path.parent)
+    return parse_scenario(data, where=str(path.name), base=path.parent, default_name=path.stem)

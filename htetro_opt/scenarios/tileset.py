@@ -23,15 +23,15 @@ Examples
 
 from __future__ import annotations
 
-import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from htetro_opt._files import atomic_path
-from htetro_opt.errors import ScenarioError, TilesetFormatError
+from htetro_opt._files import write_text
+from htetro_opt._validation import check_real
+from htetro_opt.errors import ParameterError, ScenarioError, TilesetFormatError
 from htetro_opt.model.robot import Pose
 from htetro_opt.model.tiles import identify_tile, scan_key, tile_poses
 
@@ -77,8 +77,10 @@ class Tileset:
             raise TilesetFormatError(f"{where}: occupancy must be a non-empty 2-D array, got shape {occ.shape}")
         if len(ids) != len(blocks) or len(set(ids)) != len(ids):
             raise TilesetFormatError(f"{where}: need one distinct id per tile, got {len(ids)} ids for {len(blocks)} tiles")
-        if not (math.isfinite(self.cell_size) and self.cell_size > 0):
-            raise TilesetFormatError(f"{where}: cell size must be positive, got {self.cell_size!r}")
+        try:
+            cell_size = check_real(self.cell_size, "cell size", minimum=0.0, include_minimum=False)
+        except ParameterError as err:  # tilesets come from files: the loader's error
+            raise TilesetFormatError(f"{where}: {err}") from err
         h, w = occ.shape
         for tile, cells in zip(ids, blocks):
             for letter, (x, y) in zip(BLOCK_LETTERS, cells.tolist()):
@@ -96,6 +98,7 @@ class Tileset:
         object.__setattr__(self, "occupancy", occ)
         object.__setattr__(self, "blocks", blocks)
         object.__setattr__(self, "ids", ids)
+        object.__setattr__(self, "cell_size", cell_size)
 
     @classmethod
     def from_poses(cls, occupancy, poses, *, ids=None, cell_size: float = 1.0, name: str = "") -> "Tileset":
@@ -276,6 +279,11 @@ def load_tileset(path: str | Path, *, cell_size: float = 1.0) -> Tileset:
 
 
 def save_tileset(tileset: Tileset, path: str | Path) -> None:
-    """Write a tileset's text to a file in one step (nothing half-written is left behind)."""
-    with atomic_path(path) as tmp:
-        tmp.write_text(format_tileset(tileset) + "\n", encoding="utf-8")
+    """Write a tileset's text to a file in one step (nothing half-written is left behind).
+
+    Raises
+    ------
+    OutputError
+        If the file cannot be written.
+    """
+    write_text(path, format_tileset(tileset) + "\n", what="tileset")

@@ -1,42 +1,19 @@
-"""Solvers assembled on the shared model.
+"""Solvers, one subpackage per planning task, each with one entry point taking ``method=``.
 
-- Seed 000: the exact planner, the hTetro-GA and the command-chromosome planner that runs it (or
-  pymoo's own algorithms) leg by leg.
-- Seed 003: tetromino tiling (backtracking, CP-SAT), and waypoint sequencing by the exact CP-SAT
-  optimum, OR-Tools routing, local search, the paper's GA on DEAP (plain or memetic) and the
-  zigzag / spiral / greedy baselines, all behind :func:`sequence_waypoints`.
+- :mod:`~htetro_opt.solvers.grid_paths`: :func:`plan_path` (exact Dijkstra / A*, the hTetro-GA of
+  Cheng et al. 2020 and pymoo's algorithms over command chromosomes);
+- :mod:`~htetro_opt.solvers.tiling`: :func:`tile_workspace` (Le et al. 2018: backtracking, CP-SAT);
+- :mod:`~htetro_opt.solvers.sequencing`: :func:`sequence_waypoints` (Le et al. 2018: exact,
+  OR-Tools, local search, the paper's GA, baselines).
+
+The subpackages load lazily: importing one does not import the others' dependencies.
 """
 
-from htetro_opt.solvers.exact import ALGORITHMS, Plan, plan_exact
-from htetro_opt.solvers.ga import (
-    GA_ALGORITHMS,
-    SELECTIONS,
-    ConvergenceRecorder,
-    FrontMember,
-    GAPlan,
-    LegResult,
-    make_algorithm,
-    plan_ga,
-    select_solutions,
-)
-from htetro_opt.solvers.htetro_ga import HTetroGA, trim_reached
-from htetro_opt.solvers.sequencing import EXACT_AUTO_LIMIT, SEQUENCE_SOLVERS, SequenceResult, sequence_waypoints
-from htetro_opt.solvers.termination import FrontConvergence, leading_front
-from htetro_opt.solvers.tiling import TILING_SOLVERS, enumerate_tilings, find_tiles, tile_workspace
-from htetro_opt.solvers.tsp_baselines import solve_greedy, solve_spiral, solve_zigzag
-from htetro_opt.solvers.tsp_exact import held_karp, solve_exact
-from htetro_opt.solvers.tsp_ga import solve_ga
-from htetro_opt.solvers.tsp_local import improve, nearest_neighbour, solve_local
-from htetro_opt.solvers.tsp_ortools import solve_ortools
+from htetro_opt._lazy import attach
 
-__all__ = [
-    "ALGORITHMS", "Plan", "plan_exact",
-    "GA_ALGORITHMS", "SELECTIONS", "ConvergenceRecorder", "FrontMember", "GAPlan", "LegResult",
-    "make_algorithm", "plan_ga", "select_solutions",
-    "HTetroGA", "trim_reached",
-    "FrontConvergence", "leading_front",
-    "TILING_SOLVERS", "enumerate_tilings", "find_tiles", "tile_workspace",
-    "EXACT_AUTO_LIMIT", "SEQUENCE_SOLVERS", "SequenceResult", "sequence_waypoints",
-    "solve_exact", "held_karp", "solve_ortools", "solve_local", "nearest_neighbour", "improve",
-    "solve_ga", "solve_zigzag", "solve_spiral", "solve_greedy",
-]
+__getattr__, __dir__, __all__ = attach(__name__, {
+    "plan_path": ".grid_paths", "plan_exact": ".grid_paths", "plan_ga": ".grid_paths", "Plan": ".grid_paths",
+    "PLAN_METHODS": ".grid_paths",
+    "tile_workspace": ".tiling", "enumerate_tilings": ".tiling", "find_tiles": ".tiling", "TILING_METHODS": ".tiling",
+    "sequence_waypoints": ".sequencing", "SequenceResult": ".sequencing", "SEQUENCE_METHODS": ".sequencing",
+})

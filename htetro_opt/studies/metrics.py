@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from htetro_opt.errors import ParameterError
+from htetro_opt._validation import check_int
 
 __all__ = ["format_mean_std", "group_records", "mean_std", "values_of"]
 
@@ -85,8 +85,7 @@ def mean_std(values: Iterable[float | None], *, ddof: int = 1) -> tuple[float | 
     >>> mean_std([])
     (None, None)
     """
-    if ddof not in (0, 1) or isinstance(ddof, bool):
-        raise ParameterError(f"ddof must be 0 or 1, got {ddof!r}")
+    ddof = check_int(ddof, "ddof", minimum=0, maximum=1)
     data = np.array([float(v) for v in values if v is not None], dtype=float)
     if data.size == 0:
         return None, None

@@ -1,4 +1,4 @@
-"""Seed 003's experiments re-run: Tables 1–5 of Le et al. (Electronics 2018), with the exact optimum.
+"""The experiments of Le et al. 2018 (Electronics) re-run: its Tables 1–5, with the exact optimum.
 
 The paper tiles four workspaces (6 × 6, 8 × 7, 10 × 10, and 11 × 11 with obstacles), orders the
 tiles' waypoints by its GA and by zigzag, spiral and greedy baselines, and reports:
@@ -12,14 +12,14 @@ tiles' waypoints by its GA and by zigzag, spiral and greedy baselines, and repor
   coverage time and the share of re-covered cells at heat-map thresholds 150 and 100.
 
 :func:`run_study` re-runs all of it on the paper's own labelled tilesets (bundled, transcribed from
-its figures) and on tilings of ours, with every solver of :mod:`htetro_opt.solvers.sequencing`, and
-adds what the paper could not report: each method's gap to the proven optimum (the exact solver).
+its figures) and on tilings of ours, with every method of :mod:`htetro_opt.solvers.sequencing`, and
+adds what the paper could not report: each method's gap to the proven optimum (the exact method).
 The paper's numbers sit beside ours (``PAPER_*``). Its tables do not say from which tile its paths
 start; ours start from tile 1, as its figures' paths do.
 
 Run from the command line::
 
-    python -m htetro_opt.studies.seed003 --seeds 5 --out DIR
+    htetro-opt study seed003 --seeds 5 --out DIR
 
 which prints the markdown tables and, with ``--out``, writes ``DIR/seed003.md`` and
 ``DIR/seed003.csv`` (one line per method run).
@@ -29,20 +29,17 @@ from __future__ import annotations
 
 import csv
 import io
-import sys
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
-import numpy as np
-
-from htetro_opt._argparse import Parser, UsageError
 from htetro_opt._files import atomic_path
-from htetro_opt.errors import HtetroError, ParameterError, TilingError
+from htetro_opt._validation import check_int, check_time_limit
+from htetro_opt.errors import ParameterError, TilingError
+from htetro_opt.model.coverage import simulate_coverage
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, path_cost
 from htetro_opt.scenarios import Tileset, load_scenario, load_tileset, tileset_path
 from htetro_opt.solvers.sequencing import sequence_waypoints
 from htetro_opt.solvers.tiling import tile_workspace
-from htetro_opt.studies.coverage import simulate_coverage
 from htetro_opt.studies.metrics import format_mean_std, mean_std
 
 __all__ = [
@@ -62,7 +59,6 @@ __all__ = [
     "run_study",
     "markdown_report",
     "write_csv",
-    "main",
 ]
 
 PAPER_TABLE1 = {  # method: (cost weight, path generating time s), 11 x 11, 28 waypoints
@@ -126,24 +122,26 @@ def paper_tileset(name: str) -> Tileset:
 
 def _check_seeds(seeds) -> list[int]:
     seeds = list(seeds)
-    if not seeds or any(not isinstance(s, (int, np.integer)) for s in seeds):
-        raise ParameterError(f"seeds must be a non-empty list of integers, got {seeds!r}")
-    return [int(s) for s in seeds]
+    if not seeds:
+        raise ParameterError("seeds must be a non-empty list of non-negative integers, got []")
+    return [check_int(s, f"seeds[{i}]", minimum=0) for i, s in enumerate(seeds)]
 
 
 def run_table1(tileset: Tileset, *, seeds: Iterable[int] = (0,), methods: Sequence[str] = TABLE1_METHODS,
                time_limit: float | None = None) -> list[dict]:
     """Every method on one tileset from tile 1: one record per (method, seed), with the gap to the optimum.
 
-    Deterministic methods run once (seed 0). ``time_limit`` caps each solver that takes one.
+    Deterministic methods run once (seed 0). ``time_limit`` caps each method that takes one.
     """
     seeds = _check_seeds(seeds)
+    time_limit = check_time_limit(time_limit)
     instance = SequencingInstance.from_tileset(tileset, start=tileset.ids[0])
-    optimum = sequence_waypoints(instance, "exact")
+    optimum = sequence_waypoints(instance, method="exact")
     records = []
     for method in methods:
         for seed in (seeds if method in STOCHASTIC else [0]):
-            result = optimum if method == "exact" else sequence_waypoints(instance, method, seed=seed, time_limit=time_limit)
+            result = optimum if method == "exact" else sequence_waypoints(instance, method=method, seed=seed,
+                                                                          time_limit=time_limit)
             records.append({
                 "table": 1, "tileset": tileset.name, "method": method, "seed": seed, "cost": result.cost,
                 "runtime_s": result.runtime_s, "optimum": optimum.cost,
@@ -159,7 +157,7 @@ def run_table2(tileset: Tileset) -> list[dict]:
     records = []
     for weights, meaning, paper_own, paper_four in PAPER_TABLE2:
         instance = SequencingInstance.from_tileset(tileset, start=tileset.ids[0], weights=weights)
-        result = sequence_waypoints(instance, "exact")
+        result = sequence_waypoints(instance, method="exact")
         records.append({
             "table": 2, "tileset": tileset.name, "weights": ",".join(f"{w:g}" for w in weights), "meaning": meaning,
             "cost_own": result.cost, "cost_four": path_cost(equal.cost, result.order),
@@ -168,17 +166,18 @@ def run_table2(tileset: Tileset) -> list[dict]:
     return records
 
 
-def run_table3(*, seeds: Iterable[int] = (0,), solver: str = "cpsat") -> list[dict]:
+def run_table3(*, seeds: Iterable[int] = (0,), method: str = "cpsat") -> list[dict]:
     """Table 3: alternative tilesets per workspace, each at its proven optimum from tile 1.
 
-    For every workspace: the paper's own labelled tilesets, and our tilings with each allowed-shape
-    set the paper's Table 3 names (one tiling per seed; an untileable set is recorded as such).
+    For every workspace: the paper's own labelled tilesets, and our tilings (by the tiling
+    ``method``) with each allowed-shape set the paper's Table 3 names, one tiling per seed (the
+    tiler's order shuffled by the seed); an untileable set is recorded as such.
     """
     seeds = _check_seeds(seeds)
     records = []
     for name, (scenario_name, printed) in PAPER_TILESETS.items():
         ts = paper_tileset(name)
-        optimum = sequence_waypoints(SequencingInstance.from_tileset(ts, start=ts.ids[0]), "exact")
+        optimum = sequence_waypoints(SequencingInstance.from_tileset(ts, start=ts.ids[0]), method="exact")
         records.append({"table": 3, "workspace": scenario_name, "tileset": name, "shapes": "".join(sorted(set(ts.shapes))),
                         "tiles": len(ts), "cost": optimum.cost, "paper": printed,
                         "proven": bool(optimum.info.get("optimal", False))})
@@ -188,12 +187,13 @@ def run_table3(*, seeds: Iterable[int] = (0,), solver: str = "cpsat") -> list[di
             for seed in seeds:
                 label = f"ours {shapes} seed {seed}"
                 try:
-                    ts = tile_workspace(workspace, shapes=shapes, solver=solver, seed=seed, name=label)
+                    ts = tile_workspace(workspace, shapes=shapes, method=method, shuffle=True, seed=seed,
+                                        name=label)
                 except TilingError as err:
                     records.append({"table": 3, "workspace": scenario_name, "tileset": label, "shapes": shapes,
                                     "tiles": 0, "cost": None, "paper": printed, "proven": False, "note": str(err)})
                     continue
-                optimum = sequence_waypoints(SequencingInstance.from_tileset(ts, start=1), "exact")
+                optimum = sequence_waypoints(SequencingInstance.from_tileset(ts, start=1), method="exact")
                 records.append({"table": 3, "workspace": scenario_name, "tileset": label,
                                 "shapes": "".join(sorted(set(ts.shapes))), "tiles": len(ts), "cost": optimum.cost,
                                 "paper": printed, "proven": bool(optimum.info.get("optimal", False))})
@@ -314,37 +314,3 @@ def write_csv(records: Iterable[dict], path) -> Path:
     with atomic_path(path) as tmp:
         tmp.write_text(buffer.getvalue(), encoding="utf-8")
     return Path(path)
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """Run the study from the command line; returns the exit status (0 success, 2 error)."""
-    parser = Parser(prog="python -m htetro_opt.studies.seed003", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--seeds", type=int, default=5, help="seeds of the stochastic methods (default 5)")
-    parser.add_argument("--time-limit", type=float, help="cap in seconds for each solver that takes one")
-    parser.add_argument("--out", help="directory for seed003.md and seed003.csv")
-    try:
-        args = parser.parse_args(argv)
-        if args.seeds < 1:
-            raise ParameterError(f"--seeds must be at least 1, got {args.seeds}")
-        if args.time_limit is not None and not args.time_limit > 0:
-            raise ParameterError(f"--time-limit must be positive, got {args.time_limit:g}")
-        records = run_study(seeds=range(args.seeds), time_limit=args.time_limit,
-                            progress=lambda m: print(m, file=sys.stderr, flush=True))
-        report = markdown_report(records)
-        if args.out:
-            out = Path(args.out)
-            out.mkdir(parents=True, exist_ok=True)
-            write_csv(records, out / "seed003.csv")
-            with atomic_path(out / "seed003.md") as tmp:
-                tmp.write_text(report + "\n", encoding="utf-8")
-    except (UsageError, HtetroError, OSError) as err:
-        print("error: " + " ".join(str(err).split()), file=sys.stderr)
-        return 2
-    except SystemExit as done:
-        return int(done.code or 0)
-    print(report)
-    return 0
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

@@ -1,4 +1,4 @@
-"""Seed 000's Table 4 re-run: hTetro-GA over six environments and three population sizes.
+"""Cheng et al. 2020's Table 4 re-run: hTetro-GA over six environments and three population sizes.
 
 The paper (Cheng et al., IEEE Access 2020, §V–VI) runs hTetro-GA 50 times in each of six environments
 with n_pop = 25, 50 and 100, l_p,max = 200 on the spiral map and 100 elsewhere, at most 1000
@@ -6,9 +6,9 @@ generations, and reports per cell of its Table 4 the mean ± standard deviation 
 which some individual first reaches the goal ("reach population"), the generation at which the run
 stops ("terminate population"), the wall-clock times of both, and the four fitnesses of the output
 ("multi-objective based") solution. :data:`PAPER_TABLE4` holds those numbers; :func:`run_study`
-re-runs the experiment with :func:`~htetro_opt.solvers.plan_ga` on the bundled scenarios of the same
+re-runs the experiment with :func:`~htetro_opt.solvers.grid_paths.plan_ga` on the bundled scenarios of the same
 names, and also measures what the paper could not: how far each GA plan is from the exact
-minimum-time plan (:func:`~htetro_opt.solvers.plan_exact`, same start, goal and obstacle clock).
+minimum-time plan (:func:`~htetro_opt.solvers.grid_paths.plan_exact`, same start, goal and obstacle clock).
 
 Our environments are reconstructions (the paper's figures are not in our copy, see each scenario's
 ``source``), so the generations and times need not match the paper's; the exact optimum is the
@@ -16,7 +16,7 @@ reference that does not depend on the reconstruction.
 
 Run from the command line::
 
-    python -m htetro_opt.studies.table4 --seeds 3 --pop-sizes 25,50 --envs three_slit,random \\
+    htetro-opt study table4 --seeds 3 --pop-sizes 25,50 --envs three_slit,random \\
         --max-gen 300 --jobs 2 --out DIR
 
 which writes ``DIR/table4.csv`` (one line per trial) and ``DIR/table4.md`` and prints the table.
@@ -24,29 +24,26 @@ which writes ``DIR/table4.csv`` (one line per trial) and ``DIR/table4.md`` and p
 
 from __future__ import annotations
 
-import argparse
 import csv
 import io
 import math
 import os
-import sys
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from functools import cache
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from htetro_opt._argparse import Parser, UsageError
 from htetro_opt._files import atomic_path
-from htetro_opt.errors import ConfigurationError, HtetroError, ParameterError
+from htetro_opt._validation import check_int
+from htetro_opt.algorithms import GA_ALGORITHMS
+from htetro_opt.errors import ConfigurationError, ParameterError
 from htetro_opt.model.commands import SEED000_COMMANDS
 from htetro_opt.model.robot import Pose
 from htetro_opt.model.simulate import Simulator
 from htetro_opt.scenarios import Scenario, load_scenario
-from htetro_opt.solvers.exact import plan_exact
-from htetro_opt.solvers.ga import GA_ALGORITHMS, GAPlan, plan_ga
+from htetro_opt.solvers.grid_paths import Plan, plan_exact, plan_ga
 from htetro_opt.studies.metrics import (
     format_mean_std,
     group_records,
@@ -62,7 +59,6 @@ __all__ = [
     "RECORD_FIELDS",
     "TABLE4_COLUMNS",
     "TIME_FIELDS",
-    "main",
     "markdown_table",
     "read_csv",
     "run_study",
@@ -72,7 +68,7 @@ __all__ = [
 ]
 
 ENVIRONMENTS = ("random", "spiral", "h_shape", "three_slit", "perpendicular_dynamic", "parallel_dynamic")
-"""The six environments of seed 000's Table 4, by the names of our bundled scenarios (its row order)."""
+"""The six environments of Cheng et al. 2020's Table 4, by the names of our bundled scenarios (its row order)."""
 
 MAX_LENGTH = {name: (200 if name == "spiral" else 100) for name in ENVIRONMENTS}
 """l_p,max per environment (paper §V-B3): 200 for the spiral map, 100 for the others."""
@@ -149,7 +145,7 @@ PAPER_TABLE4: dict[str, dict[int, dict[str, tuple[float, float]]]] = {
                   (1.000, 0.000), (0.537, 0.078), (0.491, 0.081), (0.171, 0.016)),
     },
 }
-"""Seed 000's Table 4: environment → n_pop → column → (mean, std), copied as printed (50 trials each).
+"""Cheng et al. 2020's Table 4: environment → n_pop → column → (mean, std), copied as printed (50 trials each).
 
 Printed oddities kept as they are: random n_pop = 25 has f_t = 0.556 ± 0.992 (the spread is probably
 0.092), and 3-slit n_pop = 25 a terminate time spread (1.07 s) far below its reach time spread.
@@ -159,7 +155,7 @@ RECORD_FIELDS = (
     "environment",
     "pop_size",
     "seed",
-    "algorithm",
+    "method",
     "max_gen",
     "patience",
     "max_length",
@@ -185,18 +181,12 @@ RECORD_FIELDS = (
 _INT_FIELDS = {"pop_size", "seed", "max_gen", "patience", "max_length", "legs", "legs_run",
                "reach_generation", "terminate_generation"}
 _BOOL_FIELDS = {"reached"}
-_STR_FIELDS = {"environment", "algorithm"}
+_STR_FIELDS = {"environment", "method"}
 TIME_FIELDS = ("reach_time_s", "terminate_time_s")
 """The wall-clock fields of a record: the only ones that differ between two runs of the same trial."""
 
 
 # --- validation ----------------------------------------------------------------------------------
-def _check_int(name: str, value: Any, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise ParameterError(f"{name} must be an integer of at least {minimum}, got {value!r}")
-    return int(value)
-
-
 def _check_environment(environment: Any) -> str:
     if not isinstance(environment, str) or environment not in ENVIRONMENTS:
         raise ParameterError(
@@ -205,39 +195,27 @@ def _check_environment(environment: Any) -> str:
     return environment
 
 
-def _check_algorithm(algorithm: Any) -> str:
-    if algorithm not in GA_ALGORITHMS:
-        raise ParameterError(f"unknown algorithm {algorithm!r}: expected one of {', '.join(GA_ALGORITHMS)}")
-    return str(algorithm)
+def _check_method(method: Any) -> str:
+    if method not in GA_ALGORITHMS:
+        raise ParameterError(f"unknown method {method!r}: expected one of {', '.join(GA_ALGORITHMS)}")
+    return str(method)
 
 
 # --- one trial -----------------------------------------------------------------------------------
-@cache
 def _environment(environment: str) -> tuple[Scenario, Simulator]:
-    """The bundled scenario and its compiled simulator (seed 000's commands), once per process."""
+    """The bundled scenario and its compiled simulator (Cheng et al. 2020's commands)."""
     scenario = load_scenario(environment)
     return scenario, Simulator(scenario.workspace, commands=SEED000_COMMANDS)
 
 
-_EXACT_CACHE: dict[tuple[str, Pose, Pose, int], tuple[float, int] | None] = {}
-
-
-def _exact_leg(environment: str, start: Pose, goal: Pose, t0: int) -> tuple[float, int] | None:
+def _exact_leg(sim: Simulator, start: Pose, goal: Pose, t0: int) -> tuple[float, int] | None:
     """(time, number of commands) of the minimum-time plan of one leg from ``start`` at clock ``t0``,
-    None if the goal cannot be reached. Cached per process; the clock only matters modulo the moving
-    obstacles' period (and not at all without them), so the cache key holds ``t0`` reduced so."""
-    _, sim = _environment(environment)
-    ws = sim.workspace
-    phase = int(t0) % ws.period if ws.moving else 0
-    key = (environment, start, goal, phase)
-    if key not in _EXACT_CACHE:
-        try:
-            plan = plan_exact(sim, [start, goal], t0=int(t0))
-        except ConfigurationError:  # the start collides with a moving obstacle at that clock
-            _EXACT_CACHE[key] = None
-        else:
-            _EXACT_CACHE[key] = (float(plan.time), len(plan.commands)) if plan.reached else None
-    return _EXACT_CACHE[key]
+    None if the goal cannot be reached."""
+    try:
+        plan = plan_exact(sim, [start, goal], t0=int(t0))
+    except ConfigurationError:  # the start collides with a moving obstacle at that clock
+        return None
+    return (float(plan.time), len(plan.commands)) if plan.reached else None
 
 
 def _sum_or_none(values: Iterable[float | None]) -> float | None:
@@ -245,8 +223,8 @@ def _sum_or_none(values: Iterable[float | None]) -> float | None:
     return None if not values or any(v is None for v in values) else float(sum(values))
 
 
-def _trial_record(environment: str, pop_size: int, seed: int, algorithm: str, max_gen: int,
-                  patience: int, plan: GAPlan, roadmap: Sequence[Pose], t_max: float) -> dict:
+def _trial_record(environment: str, pop_size: int, seed: int, method: str, max_gen: int,
+                  patience: int, plan: Plan, sim: Simulator, roadmap: Sequence[Pose], t_max: float) -> dict:
     legs = plan.legs
     reached = bool(plan.reached)
     generations = [len(leg.history) for leg in legs]  # generations run: one history row each
@@ -260,7 +238,7 @@ def _trial_record(environment: str, pop_size: int, seed: int, algorithm: str, ma
     for i, (start, goal) in enumerate(zip(roadmap[:-1], roadmap[1:])):
         if i < len(legs):
             start, goal, clock = legs[i].start, legs[i].goal, legs[i].t0
-        leg = _exact_leg(environment, start, goal, clock)
+        leg = _exact_leg(sim, start, goal, clock)
         exact_legs.append(None if leg is None else leg[0])
         if leg is None:
             break
@@ -284,7 +262,7 @@ def _trial_record(environment: str, pop_size: int, seed: int, algorithm: str, ma
         "environment": environment,
         "pop_size": pop_size,
         "seed": seed,
-        "algorithm": algorithm,
+        "method": method,
         "max_gen": max_gen,
         "patience": patience,
         "max_length": MAX_LENGTH[environment],
@@ -314,7 +292,7 @@ def run_trial(
     *,
     max_gen: int = 1000,
     patience: int = 100,
-    algorithm: str = "htetro",
+    method: str = "htetro-ga",
 ) -> dict:
     """One run of the GA through an environment's roadmap, measured as Table 4 does, plus its gap to
     the exact optimum.
@@ -326,13 +304,14 @@ def run_trial(
     pop_size : int
         n_pop.
     seed : int
-        The run's seed (:func:`~htetro_opt.solvers.plan_ga`): the same seed gives the same record,
+        The run's seed (:func:`~htetro_opt.solvers.grid_paths.plan_ga`): the same seed gives the same record,
         wall-clock fields aside.
     max_gen, patience : int, keyword-only
         Termination per leg: at most ``max_gen`` generations, or ``patience`` generations without
         improvement once the goal is reached.
-    algorithm : str, keyword-only
-        One of :data:`~htetro_opt.solvers.GA_ALGORITHMS` (default the paper's hTetro-GA).
+    method : str, keyword-only
+        One of :data:`~htetro_opt.algorithms.GA_ALGORITHMS` (default the paper's hTetro-GA with our
+        additions; ``"htetro-ga-paper"`` runs it as published).
 
     Returns
     -------
@@ -359,21 +338,21 @@ def run_trial(
     Raises
     ------
     ParameterError
-        If the environment or algorithm is unknown, or a number is out of range.
+        If the environment or method is unknown, or a number is out of range.
     """
     environment = _check_environment(environment)
-    pop_size = _check_int("pop_size", pop_size, 2)
-    seed = _check_int("seed", seed, 0)
-    max_gen = _check_int("max_gen", max_gen, 1)
-    patience = _check_int("patience", patience, 1)
-    algorithm = _check_algorithm(algorithm)
+    pop_size = check_int(pop_size, "pop_size", minimum=2)
+    seed = check_int(seed, "seed", minimum=0)
+    max_gen = check_int(max_gen, "max_gen", minimum=1)
+    patience = check_int(patience, "patience", minimum=1)
+    method = _check_method(method)
     scenario, sim = _environment(environment)
     roadmap = list(scenario.roadmap)
     max_length = MAX_LENGTH[environment]
-    plan = plan_ga(sim, roadmap, algorithm=algorithm, pop_size=pop_size, max_gen=max_gen,
+    plan = plan_ga(sim, roadmap, algorithm=method, pop_size=pop_size, max_gen=max_gen,
                    patience=patience, max_length=max_length, seed=seed)
     t_max = max_length * sim.timing.translation
-    return _trial_record(environment, pop_size, seed, algorithm, max_gen, patience, plan, roadmap, t_max)
+    return _trial_record(environment, pop_size, seed, method, max_gen, patience, plan, sim, roadmap, t_max)
 
 
 def _run_task(task: tuple[str, int, int, dict]) -> dict:
@@ -389,7 +368,7 @@ def run_study(
     *,
     max_gen: int = 1000,
     patience: int = 100,
-    algorithm: str = "htetro",
+    method: str = "htetro-ga",
     jobs: int = 1,
     progress: Callable[[int, int, dict], None] | None = None,
 ) -> list[dict]:
@@ -402,7 +381,7 @@ def run_study(
     pop_sizes : sequence of int
     seeds : iterable of int
         One trial per seed (the paper ran 50).
-    max_gen, patience, algorithm : keyword-only
+    max_gen, patience, method : keyword-only
         As for :func:`run_trial`.
     jobs : int, keyword-only
         Worker processes; above 1 the trials run in a :class:`~concurrent.futures.ProcessPoolExecutor`.
@@ -424,20 +403,20 @@ def run_study(
     if isinstance(environments, str):
         environments = [environments]
     environments = [_check_environment(e) for e in environments]
-    pop_sizes = [_check_int("pop_size", n, 2) for n in ([pop_sizes] if isinstance(pop_sizes, int) else pop_sizes)]
+    pop_sizes = [check_int(n, "pop_size", minimum=2) for n in ([pop_sizes] if isinstance(pop_sizes, int) else pop_sizes)]
     try:
-        seeds = [_check_int("seed", s, 0) for s in seeds]
+        seeds = [check_int(s, "seed", minimum=0) for s in seeds]
     except TypeError as err:
         raise ParameterError(f"seeds must be an iterable of integers, got {seeds!r}") from err
     for name, values in (("environments", environments), ("pop_sizes", pop_sizes), ("seeds", seeds)):
         if not values:
             raise ParameterError(f"{name} must not be empty")
     options = dict(
-        max_gen=_check_int("max_gen", max_gen, 1),
-        patience=_check_int("patience", patience, 1),
-        algorithm=_check_algorithm(algorithm),
+        max_gen=check_int(max_gen, "max_gen", minimum=1),
+        patience=check_int(patience, "patience", minimum=1),
+        method=_check_method(method),
     )
-    jobs = _check_int("jobs", jobs, 1)
+    jobs = check_int(jobs, "jobs", minimum=1)
     if progress is not None and not callable(progress):
         raise ParameterError(f"progress must be callable, got {progress!r}")
 
@@ -471,13 +450,13 @@ def _is_reached(record: Mapping[str, Any]) -> bool:
 
 
 def _order(key: tuple) -> tuple:
-    environment, pop_size, algorithm = key
+    environment, pop_size, method = key
     rank = ENVIRONMENTS.index(environment) if environment in ENVIRONMENTS else len(ENVIRONMENTS)
-    return rank, str(environment), pop_size if pop_size is not None else -1, str(algorithm or "")
+    return rank, str(environment), pop_size if pop_size is not None else -1, str(method or "")
 
 
 def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict]:
-    """One row per (environment, population size, algorithm): our mean ± std beside the paper's.
+    """One row per (environment, population size, method): our mean ± std beside the paper's.
 
     Parameters
     ----------
@@ -488,9 +467,9 @@ def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict]:
     -------
     list of dict
         Rows in :data:`ENVIRONMENTS` order (others after, by name), then by population size and
-        algorithm, with:
+        method, with:
 
-        - ``environment``, ``pop_size``, ``algorithm`` (None for records without one), ``runs``,
+        - ``environment``, ``pop_size``, ``method`` (None for records without one), ``runs``,
           ``reached`` (runs whose output solution has f_gr = 1) and ``reach_rate`` (their fraction);
         - for each of :data:`TABLE4_COLUMNS` ``<column>_mean`` and ``<column>_std`` (sample standard
           deviation) and the paper's ``paper_<column>_mean`` and ``paper_<column>_std`` (None where
@@ -511,17 +490,17 @@ def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict]:
     (0.5, 0.6, 20.0)
     """
     records = list(records)
-    groups = group_records(records, ["environment", "pop_size", "algorithm"])
+    groups = group_records(records, ["environment", "pop_size", "method"])
     over_reached = {"f_t", "f_sm", "f_sf"}
     rows = []
     for key in sorted(groups, key=_order):
         group = groups[key]
-        environment, pop_size, algorithm = key
+        environment, pop_size, method = key
         reached = sum(_is_reached(r) for r in group)
         row: dict[str, Any] = {
             "environment": environment,
             "pop_size": pop_size,
-            "algorithm": algorithm,
+            "method": method,
             "runs": len(group),
             "reached": reached,
             "reach_rate": reached / len(group),
@@ -565,7 +544,7 @@ def _number(value: float | None, digits: int = 1) -> str:
 def markdown_table(summary: Iterable[Mapping[str, Any]]) -> str:
     """A markdown table of :func:`summarise` rows: ours as "mean ± std", the paper's in brackets.
 
-    Columns: environment, n_pop, the algorithm (only when the rows hold more than one), runs, reached
+    Columns: environment, n_pop, the method (only when the rows hold more than one), runs, reached
     (of runs), reach and terminate generation, reach and
     terminate time, f_t, f_sm, f_sf (each "ours (paper)"), the exact optimum time, the best GA time
     (mean ± std over the runs that reached) and the gap of the best GA time to the optimum (mean, and
@@ -579,8 +558,8 @@ def markdown_table(summary: Iterable[Mapping[str, Any]]) -> str:
     True
     """
     summary = list(summary)
-    several = len({row.get("algorithm") for row in summary}) > 1
-    header = ["environment", "n_pop"] + (["algorithm"] if several else []) + ["runs", "reached"]
+    several = len({row.get("method") for row in summary}) > 1
+    header = ["environment", "n_pop"] + (["method"] if several else []) + ["runs", "reached"]
     lead = len(header)
     header += [f"{label}, ours (paper)" for _, label, _ in _MD_COLUMNS]
     header += ["exact optimum", "best GA time", "gap to optimum"]
@@ -589,7 +568,7 @@ def markdown_table(summary: Iterable[Mapping[str, Any]]) -> str:
              + "|"]
     for row in summary:
         cells = [str(row["environment"]), str(row["pop_size"])]
-        cells += [str(row.get("algorithm"))] if several else []
+        cells += [str(row.get("method"))] if several else []
         cells += [str(row["runs"]), f"{row['reached']}/{row['runs']}"]
         assert len(cells) == lead
         for column, _, digits in _MD_COLUMNS:
@@ -690,77 +669,3 @@ def read_csv(path: str | os.PathLike) -> list[dict]:
 
 
 # --- command line --------------------------------------------------------------------------------
-
-
-def _int_list(text: str) -> list[int]:
-    try:
-        values = [int(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected comma-separated integers, got {text!r}") from None
-    if not values:
-        raise argparse.ArgumentTypeError("expected at least one integer")
-    return values
-
-
-def _name_list(text: str) -> list[str]:
-    return [v.strip() for v in text.split(",") if v.strip()]
-
-
-def _parser() -> argparse.ArgumentParser:
-    p = Parser(prog="python -m htetro_opt.studies.table4",
-                description="Re-run seed 000's Table 4 (hTetro-GA) and compare every plan with the exact optimum.")
-    p.add_argument("--envs", type=_name_list, default=list(ENVIRONMENTS),
-                   help=f"comma-separated environments (default all: {','.join(ENVIRONMENTS)})")
-    p.add_argument("--pop-sizes", type=_int_list, default=list(POP_SIZES),
-                   help="comma-separated population sizes (default 25,50,100)")
-    p.add_argument("--seeds", type=int, default=50, help="number of seeds, 0 … N−1 (default 50)")
-    p.add_argument("--max-gen", type=int, default=1000, help="generation cap per leg (default 1000)")
-    p.add_argument("--patience", type=int, default=100,
-                   help="generations without improvement that end a leg (default 100)")
-    p.add_argument("--algorithm", default="htetro", help=f"one of {', '.join(GA_ALGORITHMS)} (default htetro)")
-    p.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
-    p.add_argument("--out", metavar="DIR", help="write DIR/table4.csv and DIR/table4.md")
-    p.add_argument("--progress", action="store_true", help="report each finished trial on stderr")
-    return p
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """Run the study from the command line; returns the exit status (0 success, 2 error).
-
-    Prints the markdown table; with ``--out DIR`` also writes ``DIR/table4.csv`` and
-    ``DIR/table4.md`` (DIR is created if needed). Errors print one ``error: …`` line on stderr.
-    """
-    try:
-        args = _parser().parse_args(argv)
-        if args.seeds < 1:
-            raise ParameterError(f"--seeds must be at least 1, got {args.seeds}")
-        for name in args.envs:
-            _check_environment(name)
-        out = Path(args.out) if args.out else None
-        if out is not None:
-            out.mkdir(parents=True, exist_ok=True)
-
-        def report(done: int, total: int, record: dict) -> None:
-            print(f"[{done}/{total}] {record['environment']} n_pop={record['pop_size']} seed={record['seed']}: "
-                  f"{'reached' if record['reached'] else 'not reached'} in "
-                  f"{record['terminate_generation']} generations, {record['terminate_time_s']:.1f} s",
-                  file=sys.stderr, flush=True)
-
-        records = run_study(args.envs, args.pop_sizes, range(args.seeds), max_gen=args.max_gen,
-                            patience=args.patience, algorithm=args.algorithm, jobs=args.jobs,
-                            progress=report if args.progress else None)
-        table = markdown_table(summarise(records))
-        if out is not None:
-            write_csv(records, out / "table4.csv")
-            _write_atomic(out / "table4.md", table)
-    except (UsageError, HtetroError, OSError) as err:
-        print("error: " + " ".join(str(err).split()), file=sys.stderr)
-        return 2
-    except SystemExit as done:  # --help
-        return int(done.code or 0)
-    print(table, end="")
-    return 0
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

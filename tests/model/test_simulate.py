@@ -8,6 +8,7 @@ from hypothesis import strategies as st
 from htetro_opt.errors import ConfigurationError, UnknownCommandError
 from htetro_opt.model import (
     COMMANDS,
+    STATE_NAMES,
     MovingObstacle,
     Pose,
     Simulator,
@@ -15,10 +16,10 @@ from htetro_opt.model import (
     Workspace,
     command_id,
     parse_commands,
+    shape_index,
     simulate,
     sweep_tables,
 )
-from htetro_opt.model.robot import STATE_NAMES, shape_index
 
 ALL_TOKENS = [c.token for c in COMMANDS]
 
@@ -202,12 +203,13 @@ def test_rotation_and_shapeshift_invariants(shape, heading, target, turns):
         parse_commands(["s" + target, "s" + shape]),
         parse_commands(["r+"] * turns + ["s" + target] + ["r-"] * turns),
     ]
-    r = Simulator(ws).run(seqs, start)
+    sim = Simulator(ws)
+    r = sim.run(seqs, start)
     assert r.valid.all()
     for i in range(3):
         assert tuple(r.final[i]) == (6, 6, shape_index(shape), heading)
     assert tuple(r.final[3]) == (6, 6, shape_index(target), heading)
-    assert (r.trace[:, :][:, :1] == r.trace[:, :1]).all()
+    assert (r.trace[:, 0] == sim.encode(start)).all()  # every trace begins at the start pose
     for i in range(len(seqs)):
         assert (r.poses(i)[:, :2] == (6, 6)).all()
 
@@ -217,9 +219,36 @@ def test_rotation_and_shapeshift_invariants(shape, heading, target, turns):
 def test_translations_keep_shape_and_heading_and_add_up(tokens):
     ws = Workspace(np.zeros((70, 70), dtype=bool))
     r = Simulator(ws, diagonals=True).run([parse_commands(tokens)], Pose(35, 35, "T", 2))
-    shift = np.sum([COMMANDS[command_id(t)].shift for t in tokens] or [[0, 0]], axis=0)
+    # the displacement read off the tokens' text, not off the command table the simulator uses
+    dx = sum(t.count("x+") - t.count("x-") for t in tokens)
+    dy = sum(t.count("y+") - t.count("y-") for t in tokens)
     assert r.valid[0]
-    assert tuple(r.final[0]) == (35 + shift[0], 35 + shift[1], shape_index("T"), 2)
+    assert tuple(r.final[0]) == (35 + dx, 35 + dy, shape_index("T"), 2)
+    diagonals = sum(len(t) == 4 for t in tokens)
+    assert r.time[0] == pytest.approx(len(tokens) - diagonals + diagonals * 2 ** 0.5)
+
+
+def test_repair_changes_only_what_dies():
+    # One loop serves plain and repairing runs: with nothing to repair, a repairing run is the plain run.
+    rng = np.random.default_rng(5)
+    ws = Workspace(random_map(rng, 14, 12, 0.12))
+    sim = Simulator(ws)
+    start = Pose(1, 5, "O", 0)
+    seqs = [parse_commands(list(rng.choice(["x+", "x-", "y+", "y-", "r+", "sI", "sO"], size=int(rng.integers(0, 30)))))
+            for _ in range(200)]
+    plain = sim.run(seqs, start)
+    valid = [s for s, ok in zip(seqs, plain.valid) if ok]
+    assert 10 < len(valid) < len(seqs)
+    a, b = sim.run(valid, start), sim.run(valid, start, repair=np.random.default_rng(0))
+    assert np.array_equal(a.keys, b.keys) and np.array_equal(a.local, b.local)
+    assert np.array_equal(a.time, b.time) and np.array_equal(a.executed, b.executed)
+    repaired = sim.run(seqs, start, repair=np.random.default_rng(0))
+    assert repaired.valid.sum() > plain.valid.sum()
+    for i in np.flatnonzero(plain.valid):  # valid sequences come through unchanged
+        assert np.array_equal(repaired.sequence(i), seqs[i])
+    for i in np.flatnonzero(~plain.valid):  # the others keep their prefix up to the first invalid command
+        k = plain.first_invalid[i]
+        assert np.array_equal(repaired.sequence(i)[:k], seqs[i][:k]) and repaired.sequence(i)[k] != seqs[i][k]
 
 
 def test_array_holding_objects_compare_by_identity_and_hash():

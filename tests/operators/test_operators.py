@@ -21,7 +21,7 @@ from htetro_opt.model import (
     parse_commands,
 )
 from htetro_opt.operators import (
-    DEFAULT_WEIGHTS,
+    DEFAULT_SAMPLING_WEIGHTS,
     CommandCrossover,
     CommandDuplicateElimination,
     CommandMutation,
@@ -233,18 +233,16 @@ def test_crossover_cut_points_are_independent_and_uniform():
 
 
 def test_crossover_operator_caps_at_twice_max_length():
-    from htetro_opt.operators import CommandCrossover
-
     class Stub:
         n_var, max_length = 1, 3
 
-    X = np.empty((2, 50, 1), dtype=object)
-    for k in range(50):
-        X[0, k, 0] = np.zeros(6, dtype=np.int64)
-        X[1, k, 0] = np.ones(6, dtype=np.int64)
-    Y = CommandCrossover()._do(Stub(), X, random_state=np.random.default_rng(3))
-    lengths = [len(Y[o, k, 0]) for o in range(2) for k in range(50)]
-    assert max(lengths) == 6 and min(lengths) < 6
+    pop = Population.new("X", as_column([np.zeros(6, dtype=np.int64)] * 50 + [np.ones(6, dtype=np.int64)] * 50))
+    matings = np.column_stack([np.arange(50), np.arange(50, 100)])
+    off = CommandCrossover().do(Stub(), pop, matings, random_state=np.random.default_rng(3))
+    lengths = [len(x) for x in sequences(off.get("X"))]
+    assert len(lengths) == 100 and max(lengths) == 6 and min(lengths) < 6
+    assert max(len(x) for x in sequences(CommandCrossover(max_genes=4).do(
+        Stub(), pop, matings, random_state=np.random.default_rng(3)).get("X"))) == 4
 
 
 def test_crossover_with_empty_parents():
@@ -295,7 +293,7 @@ def test_sampling_follows_the_weights():
 
 
 def test_command_sampling_defaults_to_translations(problem):
-    assert set(DEFAULT_WEIGHTS) == {"x+", "x-", "y+", "y-"}
+    assert set(DEFAULT_SAMPLING_WEIGHTS) == {"x+", "x-", "y+", "y-"}
     pop = CommandSampling().do(problem, 30, random_state=np.random.default_rng(0))
     assert len(pop) == 30
     for s in sequences(pop.get("X")):
@@ -398,12 +396,34 @@ def test_pymoo_operators_keep_their_invariants(problem):
         assert Counter(pair) == Counter(parents[i].tolist() + parents[j].tolist())
 
 
-def test_operator_rates_are_validated():
-    for make in (lambda: CommandMutation(rate=1.5), lambda: CommandMutation(rate=-0.1),
-                 lambda: CommandRemoval(translation_rate=2.0), lambda: CommandRemoval(other_rate=-1.0),
-                 lambda: CommandRearrangement(rate=1.01)):
-        with pytest.raises(ParameterError):
-            make()
+@pytest.mark.parametrize("make, words", [
+    (lambda: CommandMutation(rate=1.5), "mutation rate"),
+    (lambda: CommandMutation(rate=-0.1), "mutation rate"),
+    (lambda: CommandMutation(rate="0.1"), "mutation rate"),
+    (lambda: CommandMutation(prob=2.0), "mutation prob"),
+    (lambda: CommandRemoval(translation_rate=2.0), "removal translation_rate"),
+    (lambda: CommandRemoval(other_rate=-1.0), "removal other_rate"),
+    (lambda: CommandRemoval(prob=-1.0), "removal prob"),
+    (lambda: CommandRearrangement(rate=1.01), "rearrangement rate"),
+    (lambda: CommandRearrangement(prob=float("nan")), "rearrangement prob"),
+    (lambda: CommandCrossover(prob=1.2), "crossover prob"),
+    (lambda: CommandCrossover(max_genes=0), "max_genes"),
+    (lambda: CommandCrossover(max_genes=2.0), "max_genes"),
+    (lambda: CommandCrossover(max_genes=True), "max_genes"),
+])
+def test_operator_options_are_validated(make, words):
+    with pytest.raises(ParameterError, match=words):
+        make()
+
+
+@pytest.mark.parametrize("operator", [CommandMutation(1.0, prob=0.0), CommandRemoval(1.0, 1.0, prob=0.0),
+                                      CommandRearrangement(1.0, prob=0.0)])
+def test_prob_zero_applies_an_operator_to_nobody(problem, operator):
+    pop = _population(4, 12)
+    before = sequences(pop.get("X"))
+    after = sequences(operator.do(problem, Population.new("X", pop.get("X")),
+                                  random_state=np.random.default_rng(0)).get("X"))
+    assert same_lists(before, after)
 
 
 def test_default_mutation_rate_is_one_over_max_length(problem):

@@ -6,9 +6,19 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from pymoo.core.population import Population
 
 from htetro_opt.model import SEED000_COMMANDS, MovingObstacle, Pose, Simulator, Workspace, parse_commands
-from htetro_opt.operators import CommandRepair, CommandShortcut, as_column, cut_longest_loop, displacement
+from htetro_opt.operators import (
+    CommandRepair,
+    CommandShortcut,
+    as_column,
+    cut_longest_loop,
+    displacement,
+    longest_loops,
+    repair_and_shortcut,
+    sequences,
+)
 from htetro_opt.problems import CommandPathProblem
 
 SEED_IDS = parse_commands(",".join(SEED000_COMMANDS))
@@ -85,16 +95,22 @@ def test_sequence_drops_the_padding():
 def test_repair_operator_uses_the_problem_start_and_the_given_random_state():
     ws = cluttered(5)
     problem = CommandPathProblem(ws, Pose(2, 2, "O", 0), Pose(8, 8, "O", 0), max_length=30)
-    X = as_column(np.random.default_rng(k).choice(SEED_IDS, size=30) for k in range(10))
+    seqs = [np.random.default_rng(k).choice(SEED_IDS, size=30) for k in range(10)]
+
+    def repaired(seed):
+        pop = Population.new("X", as_column(seqs))
+        return sequences(CommandRepair().do(problem, pop, random_state=np.random.default_rng(seed)).get("X"))
+
     np.random.seed(0)
     reference = np.random.random()
     np.random.seed(0)
-    Y1 = CommandRepair()._do(problem, X, random_state=np.random.default_rng(1))
-    assert np.random.random() == reference
-    Y2 = CommandRepair()._do(problem, X, random_state=np.random.default_rng(1))
-    assert all(np.array_equal(a[0], b[0]) for a, b in zip(Y1, Y2))
-    result = problem.simulator.run([y[0] for y in Y1], problem.start_id)
-    assert result.valid.mean() > 0.5
+    first = repaired(1)
+    assert np.random.random() == reference  # the global generator is untouched
+    assert all(np.array_equal(a, b) for a, b in zip(first, repaired(1)))
+    assert not all(np.array_equal(a, b) for a, b in zip(first, repaired(2)))  # the seed matters
+    before = problem.simulator.run(seqs, problem.start_id)
+    after = problem.simulator.run(first, problem.start_id)
+    assert before.valid.sum() < 5 and after.valid.sum() > before.valid.sum() + 3
 
 
 @pytest.mark.parametrize("trace,executed,expected", [
@@ -117,7 +133,7 @@ def test_shortcut_keeps_the_end_pose_and_never_lengthens(seed):
     # valid walks that wander (repaired), so they hold loops
     walks = problem.simulator.run([rng.choice(SEED_IDS, size=40) for _ in range(10)], problem.start_id, repair=rng)
     X = as_column(walks.sequence(i)[: walks.executed[i]] for i in range(10))
-    Y = CommandShortcut()._do(problem, X, random_state=rng)
+    Y = CommandShortcut().do(problem, Population.new("X", X.copy()), random_state=rng).get("X")
     before = problem.simulate([x[0] for x in X])
     after = problem.simulate([y[0] for y in Y])
     for i in range(10):
@@ -128,27 +144,9 @@ def test_shortcut_keeps_the_end_pose_and_never_lengthens(seed):
         assert after.time[i] <= before.time[i]
 
 
-def test_as_published_switches_every_addition_off():
-    from htetro_opt.operators import CommandRepair as Repair
-    from htetro_opt.solvers import HTetroGA, make_algorithm
-
-    ours, paper = HTetroGA(10), make_algorithm("htetro-paper", 10)
-    assert isinstance(ours.repair, Repair) and ours.shortcut and ours.survival.niche_size == 3
-    assert not isinstance(paper.repair, Repair) and not paper.shortcut and paper.survival.niche_size == 0
-
-
-def test_pymoo_algorithms_get_the_repair():
-    from htetro_opt.solvers import make_algorithm
-
-    for name in ("nsga2", "nsga3", "smsemoa", "agemoea"):
-        assert isinstance(make_algorithm(name, 12).repair, CommandRepair)
-
-
 @settings(max_examples=200, deadline=None)
 @given(data=st.data())
 def test_batch_loops_match_the_one_row_version(data):
-    from htetro_opt.operators import longest_loops
-
     width = data.draw(st.integers(1, 16))
     rows = data.draw(st.lists(st.lists(st.integers(0, 4), min_size=width, max_size=width), min_size=1, max_size=4))
     trace = np.array(rows)
@@ -157,3 +155,15 @@ def test_batch_loops_match_the_one_row_version(data):
     for r in range(len(rows)):
         expected = cut_longest_loop(trace[r], int(executed[r]))
         assert (None if cut_i[r] == cut_j[r] else (int(cut_i[r]), int(cut_j[r]))) == expected
+
+
+def test_repair_and_shortcut_share_one_simulation():
+    problem = CommandPathProblem(cluttered(2), Pose(2, 2, "O", 0), Pose(9, 9, "O", 0), max_length=40)
+    seqs = [np.random.default_rng(k).choice(SEED_IDS, size=40) for k in range(8)]
+    assert all(a is b for a, b in zip(repair_and_shortcut(problem, seqs), seqs))  # nothing asked: unchanged
+    both = repair_and_shortcut(problem, seqs, repair=np.random.default_rng(3), shortcut=4)
+    repaired = repair_and_shortcut(problem, seqs, repair=np.random.default_rng(3))
+    assert all(np.array_equal(a, b) for a, b in zip(both[4:], repaired[4:]))  # only the first 4 are cut
+    cut = repair_and_shortcut(problem, repaired[:4], shortcut=4)
+    assert all(np.array_equal(a, b) for a, b in zip(both[:4], cut))  # the loops are those of the repaired paths
+    assert sum(len(a) < len(b) for a, b in zip(both[:4], repaired[:4])) > 0

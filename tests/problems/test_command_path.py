@@ -2,19 +2,21 @@
 
 import math
 
+import networkx as nx
 import numpy as np
 import pytest
 
 from htetro_opt.errors import ConfigurationError, HtetroError, ParameterError
 from htetro_opt.model import (
+    SEED000_COMMANDS,
     STATE_NAMES,
     MovingObstacle,
     Pose,
     Simulator,
     Timing,
     Workspace,
-    grid_distance,
     parse_commands,
+    shape_index,
 )
 from htetro_opt.operators import as_column
 from htetro_opt.problems import (
@@ -42,6 +44,68 @@ def ids(tokens):
 def fitness(problem, *token_lists):
     """(f_gr, f_t, f_sm, f_sf) of each sequence, through pymoo's evaluate."""
     return -problem.evaluate(as_column([ids(t) for t in token_lists]))
+
+
+def grid_steps(occ, source, target):
+    """W_A*: 4-connected steps between two free cells over free cells (networkx), None if disconnected."""
+    h, w = occ.shape
+    graph = nx.grid_2d_graph(w, h)  # nodes (x, y)
+    graph.remove_nodes_from([(x, y) for y in range(h) for x in range(w) if occ[y, x]])
+    try:
+        return nx.shortest_path_length(graph, source, target)
+    except nx.NetworkXNoPath:
+        return None
+
+
+def danger(occ, cells):
+    """Eq. 6's inner sum for one pose: 1 / ‖offset‖ over the obstacle or out-of-map cells within 2 of a block."""
+    h, w = occ.shape
+    total = 0.0
+    for bx, by in cells:
+        for dx in range(-2, 3):
+            for dy in range(-2, 3):
+                cx, cy = bx + dx, by + dy
+                if 0 < dx * dx + dy * dy <= 4 and (not (0 <= cx < w and 0 <= cy < h) or occ[cy, cx]):
+                    total += 1 / math.hypot(dx, dy)
+    return total
+
+
+DURATION = {"translation": 1.0, "rotation": 2.0, "shapeshift": 3.0}
+
+
+def kind(token):
+    return "rotation" if token.startswith("r") else "shapeshift" if token.startswith("s") else "translation"
+
+
+def oracle_fitness(ws, start, goal, tokens, max_length, successors):
+    """(f_gr, f_t, f_sm, f_sf) of one sequence by eqs. 3–6 as the paper states them, executed command by
+    command by the test suite's own validity model, stopping at the first invalid command or the goal."""
+    pose = (start.x, start.y, shape_index(start.shape), start.heading)
+    target = (goal.x, goal.y, shape_index(goal.shape), goal.heading)
+    executed, poses = [], []
+    for t, token in enumerate(tokens):
+        if pose == target:
+            break
+        moves = {tok: nxt for tok, nxt, _ in successors(ws, pose, t, SEED000_COMMANDS)}
+        if token not in moves:
+            break
+        pose = moves[token]
+        executed.append(token)
+        poses.append(pose)
+    n = len(executed)
+    steps = grid_steps(ws.occupancy, pose[:2], target[:2])
+    if pose == target:
+        f_gr = 1.0
+    elif steps is None:
+        f_gr = 0.0
+    else:
+        f_gr = 1 / (1 + (steps if steps else 0.5))  # the goal cell in another shape or heading: half a cell
+    f_t = 1 - sum(DURATION[kind(t)] for t in executed) / max_length
+    changes = sum(a != b for a, b in zip(executed, executed[1:]))
+    f_sm = 1 - changes / (n - 1) if n > 1 else 1.0
+    penalty = sum(danger(ws.occupancy, Pose(x, y, STATE_NAMES[s], h).cells().tolist()) for x, y, s, h in poses)
+    f_sf = 1 - penalty / (n * (6 + 2 * SQRT2)) if n else 1.0
+    return [f_gr, f_t, f_sm, f_sf], n, pose == target
 
 
 @pytest.fixture(scope="module")
@@ -95,9 +159,10 @@ def test_goal_reachability_uses_the_grid_distance_around_obstacles():
     f = fitness(problem, "x+", "y+,y+")
     # from (4, 3): up to row 9 (6), across to column 9 (5), down to row 3 (6) — not the 5 cells straight across
     assert f[0, 0] == pytest.approx(1 / (1 + 17))
-    distance = grid_distance(ws, (9, 3))
-    assert f[1, 0] == pytest.approx(1 / (1 + distance[5, 3]))
-    assert distance[5, 3] == 16  # from (3, 5): up 4, across 6, down 6
+    assert grid_steps(occ, (4, 3), (9, 3)) == 17
+    # from (3, 5): up 4, across 6, down 6
+    assert grid_steps(occ, (3, 5), (9, 3)) == 16
+    assert f[1, 0] == pytest.approx(1 / (1 + 16))
 
 
 def test_unreachable_goal_cell_scores_zero():
@@ -206,35 +271,44 @@ def test_safety_hand_computed():
     assert f[0, 3] == pytest.approx(1 - (6 + 4 * SQRT2) / (6 + 2 * SQRT2))
 
 
-def test_safety_matches_a_direct_sum_on_a_cluttered_map():
-    rng = np.random.default_rng(11)
+@pytest.mark.parametrize("map_seed", [11, 12])
+def test_objectives_match_an_independent_oracle_on_a_cluttered_map(map_seed, successors):
+    rng = np.random.default_rng(map_seed)
     occ = rng.random((10, 12)) < 0.12
-    occ[3:7, 3:7] = False
+    occ[2:9, 2:8] = False  # room to turn the I-shape round at the start
+    occ[5, 8] = True  # an obstacle near the goal
     ws = Workspace(occ)
-    problem = CommandPathProblem(ws, Pose(4, 5, "O", 0), Pose(5, 5, "I", 2), max_length=20)
+    start, goal = Pose(4, 5, "O", 0), Pose(5, 4, "I", 2)
+    problem = CommandPathProblem(ws, start, goal, max_length=12)
     tokens = ["x+", "x-", "y+", "y-", "r+", "r-", "sI", "sO", "sL", "sT"]
-    seqs = [parse_commands(list(rng.choice(tokens, size=rng.integers(1, 12)))) for _ in range(60)]
-    result = problem.simulate(seqs)
-    f_sf = problem.fitness(result)[:, 3]
-    assert (result.executed >= 3).sum() >= 10
-    for i in range(len(seqs)):
-        n = int(result.executed[i])
-        total = 0.0
-        for x, y, s, h in result.poses(i)[1:].tolist():
-            for bx, by in Pose(x, y, STATE_NAMES[s], h).cells().tolist():
-                for dx in range(-2, 3):
-                    for dy in range(-2, 3):
-                        cx, cy = bx + dx, by + dy
-                        if 0 < dx * dx + dy * dy <= 4 and (not (0 <= cx < 12 and 0 <= cy < 10) or occ[cy, cx]):
-                            total += 1 / math.hypot(dx, dy)
-        assert f_sf[i] == pytest.approx(1 - total / (n * SAFETY_COEFFICIENT) if n else 1.0)
+    runs = [list(rng.choice(tokens, size=rng.integers(0, 14))) for _ in range(80)]
+    runs += [["sI", "r+", "r+", "y-", "x+"], ["sI", "r+", "r+", "x+", "y-", "sO"]]  # reaching the goal, then more
+    F, executed, reached = problem.evaluate(as_column([ids(t) for t in runs]),
+                                            return_values_of=["F", "executed", "reached"])
+    seen = set()
+    for i, tokens_i in enumerate(runs):
+        expected, n, hit = oracle_fitness(ws, start, goal, tokens_i, 12, successors)
+        assert int(executed[i]) == n and bool(reached[i]) == hit
+        assert (-F[i]).tolist() == pytest.approx(expected)
+        seen.add((hit, n > 1, n < len(tokens_i)))
+    assert {(True, True, True), (False, True, False), (False, True, True)} <= seen  # the sample covers the cases
 
 
-def test_fitness_and_evaluate_agree(open_problem):
-    seqs = [ids("x+,y+,sI"), ids("x-,x-"), ids(""), ids("y+,y+,y+,x+,x+,x+,x+,x+")]
-    F = open_problem.evaluate(as_column(seqs))
-    assert F.shape == (4, 4)
-    assert np.array_equal(F, -open_problem.fitness(open_problem.simulate(seqs)))
+def test_objectives_of_a_hand_computed_run():
+    # A 6 × 5 open map (only the outside counts as obstacle); the O-shape from (1, 1) towards (3, 2).
+    ws = Workspace(np.zeros((5, 6), dtype=bool))
+    problem = CommandPathProblem(ws, Pose(1, 1, "O", 0), Pose(3, 2, "O", 0), max_length=4)
+    f = fitness(problem, "x+,sI", "x+,x+,y+,y-")
+    # x+, then sI: 2 commands, 1 change, 1 + 3 = 4 s of t_max = 4 s; B2 ends on (2, 1), 2 steps from (3, 2).
+    # After x+ the O covers (2, 0), (3, 0) on the bottom row, whose (0, −1), (±1, −1), (0, −2) lie outside
+    # the map, and (2, 1), (3, 1), whose (0, −2) does; after sI the I covers (2, 0) (as before), (2, 1)
+    # (as before), (2, 2) (nothing outside within 2) and (2, 3), whose (0, +2) lies outside.
+    bottom, second = 1 + 2 / SQRT2 + 0.5, 0.5
+    after_x = 2 * bottom + 2 * second
+    after_i = bottom + second + 0 + 0.5
+    assert f[0].tolist() == pytest.approx([1 / 3, 1 - 4 / 4, 1 - 1 / 1, 1 - (after_x + after_i) / (2 * (6 + 2 * SQRT2))])
+    # x+, x+, y+ reaches (3, 2): the child stops there, y- is never executed
+    assert f[1, :3].tolist() == pytest.approx([1.0, 1 - 3 / 4, 1 - 1 / 2])
 
 
 # --- parameters and configurations -------------------------------------------------------------

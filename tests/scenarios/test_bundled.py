@@ -5,7 +5,7 @@ import pytest
 
 from htetro_opt.model import Simulator
 from htetro_opt.scenarios import Scenario, list_scenarios, load_scenario
-from htetro_opt.solvers import plan_exact
+from htetro_opt.solvers.grid_paths import plan_exact
 
 SEED_000 = ["random", "h_shape", "spiral", "three_slit", "perpendicular_dynamic", "parallel_dynamic"]
 SIZES = {
@@ -62,11 +62,17 @@ def test_moving_obstacles_are_in_the_way(scenarios, name):
     assert not Simulator(sc.workspace).run([static.commands], sc.start).valid[0]
 
 
-@pytest.mark.parametrize("name", [n for n in sorted(SIZES) if not n.startswith("tiling")])
+WITHOUT_ROADMAP = {n for n in SIZES if n.startswith("tiling")} | {"coverage_16x16"}  # tiling maps only
+
+
+def test_only_the_tiling_maps_have_no_roadmap(scenarios):
+    assert {n for n in SIZES if not scenarios[n].roadmap} == WITHOUT_ROADMAP
+    assert all(scenarios[n].goal is None for n in WITHOUT_ROADMAP)
+
+
+@pytest.mark.parametrize("name", sorted(set(SIZES) - WITHOUT_ROADMAP))
 def test_every_roadmap_is_solvable_and_the_plan_revalidates(scenarios, name):
     sc = scenarios[name]
-    if sc.goal is None:
-        pytest.skip("no goal to plan for")
     diagonals = name in ("zigzag", "maze", "maze_partial", "indoor_room")  # seed 001 moves diagonally
     plan = plan_exact(sc.workspace, sc.roadmap, diagonals=diagonals)
     assert plan.reached
@@ -107,3 +113,11 @@ def test_tiling_11x11_obstacles_of_fig_12d(scenarios):
     occ = scenarios["tiling_11x11"].workspace.occupancy
     cells = sorted(map(tuple, np.argwhere(occ)[:, ::-1].tolist()))
     assert cells == sorted([(8, 10), (9, 10), (8, 9), (9, 9), (4, 4), (5, 4), (8, 4), (4, 3), (5, 3)])
+
+
+def test_every_bundled_scenario_says_where_it_comes_from_and_what_it_is():
+    # A user's file may leave source and description out; the bundled library never does.
+    for name in list_scenarios():
+        scenario = load_scenario(name)
+        assert scenario.source.strip(), name
+        assert scenario.description.strip(), name

@@ -274,12 +274,29 @@ def test_non_utf8_file_raises_scenario_error(tmp_path):
         load_scenario_file(path)
 
 
-@pytest.mark.parametrize("key", ["name", "source"])
-def test_missing_name_or_source(key):
+def test_a_table_without_a_name_and_no_file_to_name_it_after_is_refused():
     with pytest.raises(ScenarioError) as info:
-        parse_scenario(grid_data(**{key: None}), where="s.toml")
+        parse_scenario(grid_data(name=None), where="s.toml")
     msg = str(info.value)
-    assert "s.toml" in msg and f"missing key {key!r}" in msg
+    assert "s.toml" in msg and "missing key 'name'" in msg
+
+
+def test_a_users_file_needs_neither_name_nor_source(tmp_path):
+    path = write(tmp_path / "my_room.toml", 'grid = """\n#....#\n#....#\n"""\n')
+    scenario = load_scenario_file(path)
+    assert scenario.name == "my_room" and scenario.source == "" and scenario.description == ""
+
+
+def test_a_byte_order_mark_is_accepted(tmp_path):
+    path = tmp_path / "bom.toml"
+    path.write_bytes("\ufeffname = \"bom\"\ngrid = \"\"\"\n....\n....\n\"\"\"\n".encode("utf-8"))
+    assert load_scenario_file(path).name == "bom"
+
+
+@pytest.mark.parametrize("key", ["source", "description"])
+def test_source_and_description_must_be_text(key):
+    with pytest.raises(ScenarioError, match=f"'{key}' must be a string"):
+        parse_scenario(grid_data(**{key: 3}), where="s.toml")
 
 
 def test_mistyped_name():
@@ -758,7 +775,6 @@ def test_continuous_robot_outside_the_rectangle(tmp_path, point, key):
     (("width = 10.0", "width = 0"), "width"),
     (("height = 8\n", "height = 8\ncolour = 1\n"), "colour"),
     (("start = [4, 4]", "start = [4, 4, 1]"), "robots[2]"),
-    (("name = \"field\"\n", ""), "missing key 'name'"),
 ])
 def test_continuous_errors(tmp_path, change, words):
     text = CONTINUOUS.replace(*change)
@@ -766,6 +782,11 @@ def test_continuous_errors(tmp_path, change, words):
     with pytest.raises(ScenarioError) as info:
         load_scenario_file(write(tmp_path / "c.toml", text))
     assert words in str(info.value)
+
+
+def test_a_continuous_file_without_a_name_is_named_after_the_file(tmp_path):
+    text = CONTINUOUS.replace("name = \"field\"\n", "")
+    assert load_scenario_file(write(tmp_path / "open_air.toml", text)).name == "open_air"
 
 
 @pytest.mark.parametrize("change", [

@@ -1,11 +1,23 @@
-"""Seed 003's study (Tables 1–5): records, gaps to the optimum, the report and the command line."""
+"""The study of Le et al. 2018 (Tables 1–5): records, gaps to the optimum, the report and the command line."""
 
 import csv
+from itertools import pairwise
 
+import numpy as np
 import pytest
 
+from htetro_opt.cli import main as cli_main
 from htetro_opt.errors import ParameterError
+from htetro_opt.problems import SequencingInstance
+from htetro_opt.solvers.sequencing import held_karp
 from htetro_opt.studies import seed003
+
+
+def eq2_cost(tileset, tiles, weights=(0.25,) * 4):
+    """Eq. 2 summed along an order of tile labels, block by block (by hand)."""
+    blocks = {t: np.asarray(b, dtype=float) for t, b in zip(tileset.ids, tileset.blocks)}
+    return sum(w * float(np.hypot(*(blocks[a][k] - blocks[b][k])))
+               for a, b in pairwise(tiles) for k, w in enumerate(weights))
 
 
 @pytest.fixture(scope="module")
@@ -18,25 +30,30 @@ def table1(fig13b):
     return seed003.run_table1(fig13b, seeds=[0, 1], methods=("zigzag", "greedy", "ga-plain", "ga", "exact"))
 
 
-def test_table1_gaps_are_measured_against_the_proven_optimum(table1):
+def test_table1_gaps_are_measured_against_the_proven_optimum(fig13b, table1):
+    # 14 waypoints: Held–Karp gives the optimum independently of CP-SAT
+    _, truth = held_karp(SequencingInstance.from_tileset(fig13b, start=1).cost, start=0)
     optimum = [r for r in table1 if r["method"] == "exact"][0]
     assert optimum["proven"] and optimum["gap_pct"] == 0
+    assert optimum["cost"] == pytest.approx(truth, rel=1e-9)
     for r in table1:
-        assert r["optimum"] == optimum["cost"]
-        assert r["cost"] >= optimum["cost"] - 1e-9  # nothing beats a proven optimum
-        assert r["gap_pct"] == pytest.approx(100 * (r["cost"] - optimum["cost"]) / optimum["cost"])
         assert r["order"][0] == 1 and sorted(r["order"]) == list(range(1, 15))
+        cost = eq2_cost(fig13b, r["order"])
+        assert r["cost"] == pytest.approx(cost) and r["optimum"] == pytest.approx(truth, rel=1e-9)
+        assert r["gap_pct"] == pytest.approx(100 * (cost - truth) / truth, abs=1e-6)
     assert [r["seed"] for r in table1 if r["method"] == "greedy"] == [0, 1]  # stochastic: one run per seed
     assert [r["seed"] for r in table1 if r["method"] == "zigzag"] == [0]
 
 
 def test_table2_prices_each_weight_settings_optimum_with_equal_weights(fig13b):
     rows = seed003.run_table2(fig13b)
-    assert len(rows) == len(seed003.PAPER_TABLE2)
+    assert [r["weights"] for r in rows] == [",".join(f"{w:g}" for w in ws) for ws, *_ in seed003.PAPER_TABLE2]
     equal = rows[-1]
-    assert equal["cost_own"] == pytest.approx(equal["cost_four"])
-    for r in rows:
+    for r, (weights, *_) in zip(rows, seed003.PAPER_TABLE2):
         assert r["proven"]
+        # each setting's optimum, against Held–Karp on that setting's costs
+        own = SequencingInstance.from_tileset(fig13b, start=1, weights=weights)
+        assert r["cost_own"] == pytest.approx(held_karp(own.cost, start=0)[1], rel=1e-9)
         # the equal-weight optimum is the cheapest path at equal weights
         assert r["cost_four"] >= equal["cost_four"] - 1e-9
 
@@ -66,13 +83,18 @@ def test_report_puts_the_papers_numbers_beside_ours_and_csv_round_trips(tmp_path
 def test_bad_seeds_and_command_line_errors(capsys):
     with pytest.raises(ParameterError, match="seeds"):
         seed003.run_table1(None, seeds=[])
-    assert seed003.main(["--seeds", "0"]) == 2
-    assert seed003.main(["--time-limit", "-1"]) == 2
+    for bad in (-1, 1.5, True):
+        with pytest.raises(ParameterError, match=r"seeds\[1\] must be a non-negative integer"):
+            seed003.run_table1(None, seeds=[0, bad])
+    assert cli_main(["study", "seed003", "--seeds", "0"]) == 2
+    assert cli_main(["study", "seed003", "--time-limit", "-1"]) == 2
+    assert cli_main(["study", "seed003", "--time-limit", "inf"]) == 2
     err = capsys.readouterr().err.splitlines()
-    assert len(err) == 2 and all(line.startswith("error: ") for line in err)
+    assert len(err) == 3 and all(line.startswith("error: ") for line in err)
+    assert "--seeds" in err[0] and all("--time-limit" in line for line in err[1:])
 
 
 @pytest.mark.slow
 def test_the_whole_study_runs_and_writes_its_files(tmp_path):
-    assert seed003.main(["--seeds", "1", "--out", str(tmp_path)]) == 0
+    assert cli_main(["study", "seed003", "--seeds", "1", "--out", str(tmp_path)]) == 0
     assert (tmp_path / "seed003.md").read_text().count("### Table") >= 4

@@ -1,0 +1,107 @@
+"""The pymoo algorithms that run over seed 000's command chromosomes, by name.
+
+The same :class:`~htetro_opt.problems.CommandPathProblem` and operators run under the paper's
+hTetro-GA (with our additions, or as published) and under four of pymoo's own algorithms, so that a
+study can swap the algorithm and nothing else.
+"""
+
+from __future__ import annotations
+
+from math import comb
+from typing import Mapping
+
+from htetro_opt._validation import check_int, check_probability
+from htetro_opt.algorithms.htetro_ga import HTetroGA
+from htetro_opt.errors import ParameterError
+from htetro_opt.operators.commands import (
+    CommandCrossover,
+    CommandDuplicateElimination,
+    CommandMutation,
+    CommandRepair,
+    CommandSampling,
+)
+
+__all__ = ["GA_ALGORITHMS", "make_algorithm"]
+
+GA_ALGORITHMS = ("htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea")
+"""Algorithm names :func:`make_algorithm` knows: the hTetro-GA with our additions, as published, and
+four of pymoo's."""
+
+
+def make_algorithm(
+    name: str = "htetro-ga",
+    pop_size: int = 50,
+    *,
+    sampling_weights: Mapping[str, float] | None = None,
+    crossover_rate: float = 0.5,
+):
+    """A pymoo algorithm over command chromosomes.
+
+    Parameters
+    ----------
+    name : {"htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea"}
+        ``"htetro-ga"`` is :class:`HTetroGA` with our repair, shortcut and niching, ``"htetro-ga-paper"``
+        :meth:`HTetroGA.as_published`; the others are pymoo's algorithms with the command sampling,
+        single-point crossover (rate ``crossover_rate``), mutation, duplicate elimination and the
+        repair (NSGA-III with Das–Dennis reference directions, about ``pop_size`` of them).
+    pop_size : int
+    sampling_weights : mapping of token to float, optional
+        λ_mc of Algorithm 1.
+    crossover_rate : float
+
+    Raises
+    ------
+    ParameterError
+        If the name is unknown, ``pop_size`` is below 2, ``crossover_rate`` is not a probability, a
+        sampling weight is negative, or ``"agemoea"`` is asked for without numba installed (pymoo's
+        AGE-MOEA needs it: the ``agemoea`` extra).
+
+    Examples
+    --------
+    >>> type(make_algorithm("nsga2", 20)).__name__, make_algorithm("htetro-ga-paper", 20).shortcut
+    ('NSGA2', False)
+    """
+    if name not in GA_ALGORITHMS:
+        raise ParameterError(f"unknown algorithm {name!r}: expected one of {', '.join(GA_ALGORITHMS)}")
+    pop_size = check_int(pop_size, "pop_size", minimum=2)
+    crossover_rate = check_probability(crossover_rate, "crossover_rate")
+    sampling = CommandSampling(sampling_weights)
+    if name == "htetro-ga":
+        return HTetroGA(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate)
+    if name == "htetro-ga-paper":
+        return HTetroGA.as_published(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate)
+    operators = dict(
+        sampling=sampling,
+        crossover=CommandCrossover(prob=crossover_rate),
+        mutation=CommandMutation(),
+        eliminate_duplicates=CommandDuplicateElimination(),
+        repair=CommandRepair(),
+    )
+    if name == "nsga2":
+        from pymoo.algorithms.moo.nsga2 import NSGA2
+
+        return NSGA2(pop_size=pop_size, **operators)
+    if name == "nsga3":
+        from pymoo.algorithms.moo.nsga3 import NSGA3
+        from pymoo.util.ref_dirs import get_reference_directions
+
+        partitions = 1
+        while _n_directions(4, partitions + 1) <= pop_size:
+            partitions += 1
+        ref_dirs = get_reference_directions("das-dennis", 4, n_partitions=partitions)
+        return NSGA3(ref_dirs=ref_dirs, pop_size=pop_size, **operators)
+    if name == "smsemoa":
+        from pymoo.algorithms.moo.sms import SMSEMOA
+
+        return SMSEMOA(pop_size=pop_size, **operators)
+    try:
+        from pymoo.algorithms.moo.age import AGEMOEA
+    except Exception as err:  # pymoo's AGE-MOEA module turns a missing numba into a bare Exception
+        raise ParameterError(
+            f"algorithm 'agemoea' needs numba, which pymoo's AGE-MOEA imports: pip install 'htetro-opt[agemoea]' ({err})"
+        ) from err
+    return AGEMOEA(pop_size=pop_size, **operators)
+
+
+def _n_directions(n_obj: int, partitions: int) -> int:
+    return comb(partitions + n_obj - 1, n_obj - 1)

@@ -1,0 +1,19 @@
+"""Grid path planning through a roadmap of configurations: :func:`plan_path` with ``method=``.
+
+- ``"dijkstra"``, ``"astar"`` (:func:`plan_exact`): the minimum-time plan over (x, y, shape,
+  heading), time-expanded for moving obstacles: the exact reference of every heuristic;
+- ``"htetro-ga"``, ``"htetro-ga-paper"``, ``"nsga2"``, ``"nsga3"``, ``"smsemoa"``, ``"agemoea"``
+  (:func:`plan_ga`): Cheng et al. 2020's multi-objective GA over motion-command chromosomes, or one
+  of pymoo's algorithms over the same problem, leg by leg.
+
+Every method returns a :class:`Plan`, re-validated in the simulator.
+"""
+
+from htetro_opt._lazy import attach
+
+__getattr__, __dir__, __all__ = attach(__name__, {
+    "plan_path": "._dispatch", "PLAN_METHODS": "._dispatch",
+    "Plan": "._result", "FrontMember": "._result", "LegResult": "._result",
+    "plan_exact": "._exact", "EXACT_METHODS": "._exact",
+    "plan_ga": "._ga",
+})

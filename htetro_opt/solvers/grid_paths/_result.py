@@ -1,0 +1,192 @@
+"""The one result type of grid path planning, and the one place a plan is re-validated.
+
+Every method of :func:`~htetro_opt.solvers.grid_paths.plan_path` returns a :class:`Plan`, built by
+:func:`finish_plan`, which replays the commands in the simulator from the roadmap's start: a method
+cannot report a time, a pose or a validity its commands do not have.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from htetro_opt.errors import PlanningError
+from htetro_opt.model.commands import COMMANDS
+from htetro_opt.model.robot import Pose
+from htetro_opt.model.simulate import Simulator
+from htetro_opt.model.workspace import Workspace
+from htetro_opt.problems.command_path import FITNESS_NAMES
+
+__all__ = ["Plan", "FrontMember", "LegResult", "finish_plan", "prepare"]
+
+
+@dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
+class FrontMember:
+    """One GA individual: its executed commands (global ids), fitnesses, time and the poses it visits
+    ((x, y, state, heading) rows, its leg's start first)."""
+
+    commands: np.ndarray
+    fitness: np.ndarray  # (f_gr, f_t, f_sm, f_sf)
+    time: float
+    reached: bool
+    poses: np.ndarray
+
+    @property
+    def tokens(self) -> list[str]:
+        return [COMMANDS[int(c)].token for c in self.commands]
+
+    def as_dict(self) -> dict:
+        return {
+            "fitness": {name: float(v) for name, v in zip(FITNESS_NAMES, self.fitness)},
+            "time": float(self.time),
+            "reached": bool(self.reached),
+            "commands": self.tokens,
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class LegResult:
+    """One leg of a GA's configuration loop: its final leading front, selections and convergence.
+
+    ``reach_generation`` is the first generation (1 = the initial population) holding an individual
+    that reaches the leg's goal, None if none ever did; ``history`` holds, per generation, the four
+    fitnesses of that generation's multi-objective solution (the paper's Fig. 10).
+    """
+
+    start: Pose
+    goal: Pose
+    t0: int
+    reached: bool
+    front: tuple[FrontMember, ...]
+    selected: Mapping[str, FrontMember]
+    reach_generation: int | None
+    reach_time_s: float | None
+    generations: int
+    converged: bool
+    runtime_s: float
+    history: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
+class Plan:
+    """A plan through a roadmap, whatever the method: global command ids from the start, and what
+    they achieve (re-validated in the simulator).
+
+    Attributes
+    ----------
+    method : str
+        The method that made it (``"dijkstra"``, ``"astar"``, ``"htetro-ga"``, …; a hand-over from
+        Dijkstra to A* shows as ``"dijkstra (astar)"``).
+    commands : ndarray of int64
+        Global command ids, from the roadmap's start.
+    reached : bool
+        False when some leg was not solved; ``commands`` then holds the legs before it.
+    time : float
+        Duration of the commands.
+    poses : ndarray, shape (len(commands) + 1, 4)
+        (x, y, state, heading) after each command, the start first.
+    leg_ends : tuple of int
+        Number of commands at the end of each solved leg.
+    failed_leg : int
+        Index of the leg that was not solved, −1 when reached.
+    runtime_s : float
+    legs : tuple of LegResult
+        The GAs' per-leg records (fronts, selections, convergence); empty for the graph searches.
+    info : dict
+        Other method-specific extras (JSON-ready); for a callable method whose answer did not solve
+        every leg, ``returned`` (the answer's length) and ``first_invalid`` (its first invalid
+        command, −1 if none).
+    """
+
+    method: str
+    commands: np.ndarray
+    reached: bool
+    time: float
+    poses: np.ndarray
+    leg_ends: tuple[int, ...]
+    failed_leg: int = -1
+    runtime_s: float = 0.0
+    legs: tuple[LegResult, ...] = ()
+    info: Mapping = field(default_factory=dict)
+
+    @property
+    def tokens(self) -> list[str]:
+        return [COMMANDS[int(c)].token for c in self.commands]
+
+    @property
+    def reach_generation(self) -> int | None:
+        """GAs: the largest first-reach generation over the legs (None if some leg never reached, and
+        for the graph searches)."""
+        gens = [leg.reach_generation for leg in self.legs]
+        return None if not gens or None in gens else max(gens)
+
+    def objectives(self) -> dict:
+        """Path metrics: time, number of commands by kind, B2's travelled distance.
+
+        Seed 004's ``2l/2r`` count as rotations, its other block commands as shapeshifts.
+        """
+        commands = [COMMANDS[int(c)] for c in self.commands]
+        moves = [c for c in commands if c.kind in ("translation", "diagonal")]
+        turns = [c for c in commands if c.turn != 0]
+        return {
+            "time": float(self.time),
+            "n_commands": len(commands),
+            "translations": len(moves),
+            "rotations": len(turns),
+            "shapeshifts": sum(c.kind == "shapeshift" or any(c.hinge_delta) for c in commands),
+            "path_length": float(sum(math.hypot(*c.shift) for c in moves)),
+        }
+
+
+def finish_plan(sim: Simulator, commands: np.ndarray, start: int, *, t0: int = 0, method: str,
+                leg_ends, failed_leg: int, began: float, legs=(), info=None) -> Plan:
+    """Replay ``commands`` from pose id ``start`` (at time ``t0``) and wrap them as a :class:`Plan`.
+
+    Raises
+    ------
+    PlanningError
+        If the commands do not re-validate: a method's bug, never the user's input.
+    """
+    commands = np.asarray(commands, dtype=np.int64)
+    result = sim.run([commands], start, t0=t0)
+    if not result.valid[0]:
+        raise PlanningError(f"internal error: the {method} plan does not re-validate in the simulator "
+                            f"(command {int(result.first_invalid[0]) + 1} of {len(commands)} is invalid)")
+    return Plan(
+        method=method,
+        commands=commands,
+        reached=failed_leg < 0,
+        time=float(result.time[0]),
+        poses=result.poses(0),
+        leg_ends=tuple(int(e) for e in leg_ends),
+        failed_leg=int(failed_leg),
+        runtime_s=time.perf_counter() - began,
+        legs=tuple(legs),
+        info=dict(info or {}),
+    )
+
+
+def prepare(workspace: Workspace | Simulator, roadmap: Sequence[Pose], *, t0: int = 0,
+            **compile_options) -> tuple[Simulator, list[Pose], list[int]]:
+    """The simulator (compiled unless given), the roadmap as poses and their pose ids, all checked
+    before any planning starts.
+
+    Raises
+    ------
+    PlanningError
+        If the roadmap has fewer than two configurations.
+    ConfigurationError
+        If the start collides (at time ``t0``) or a configuration lies outside the map.
+    """
+    roadmap = [Pose.of(*p) for p in roadmap]
+    if len(roadmap) < 2:
+        raise PlanningError("a roadmap needs a start and a goal (at least two configurations)")
+    sim = workspace if isinstance(workspace, Simulator) else Simulator(workspace, **compile_options)
+    ids = [sim.check_pose(roadmap[0], what="start", t=t0)]
+    for i, pose in enumerate(roadmap[1:], start=1):
+        ids.append(sim.check_pose(pose, what="goal" if i == len(roadmap) - 1 else f"roadmap configuration {i + 1}"))
+    return sim, roadmap, ids

@@ -1,0 +1,31 @@
+"""Waypoint sequencing (Le et al. 2018): order a tileset's waypoints as an open path of least eq.-2 cost.
+
+:func:`sequence_waypoints` runs one method (``method=``, a name of :data:`SEQUENCE_METHODS` or a
+callable) and returns a :class:`SequenceResult` re-priced on the instance. The methods, each also a
+function of its own:
+
+- ``exact`` (:func:`solve_exact`): the CP-SAT optimum with a proof, up to 40 waypoints;
+  :func:`held_karp` is the independent dynamic-programming reference (≤ 16);
+- ``ortools`` (:func:`solve_ortools`): OR-Tools routing with guided local search, the paper's baseline;
+- ``local`` (:func:`solve_local`): nearest neighbour, 2-opt and Or-opt, optionally iterated;
+  :func:`nearest_neighbour_paths` is the one nearest-neighbour construction (the exact solver's
+  hint and the greedy baseline use it too), :func:`improve` / :func:`improve_batch` the one
+  2-opt/Or-opt local search (the memetic GA uses it too);
+- ``ga``, ``ga-plain`` (:func:`solve_ga`): the paper's GA on DEAP, with or without a memetic step;
+- ``zigzag``, ``zigzag2``, ``spiral``, ``spiral2``, ``greedy``: the paper's baselines.
+"""
+
+from htetro_opt._lazy import attach
+
+__getattr__, __dir__, __all__ = attach(__name__, {
+    "sequence_waypoints": "._dispatch", "SequenceResult": "._dispatch", "SEQUENCE_METHODS": "._dispatch",
+    "EXACT_AUTO_LIMIT": "._dispatch",
+    "solve_exact": "._exact", "held_karp": "._exact", "EXACT_MAX_SIZE": "._exact",
+    "solve_ortools": "._ortools", "ortools_time_limit": "._ortools", "FIRST_SOLUTIONS": "._ortools",
+    "solve_local": "._local", "nearest_neighbour": "._local", "nearest_neighbour_paths": "._local",
+    "two_opt": "._local", "or_opt": "._local", "improve": "._local", "improve_batch": "._local",
+    "double_bridge": "._local",
+    "solve_ga": "._ga", "make_toolbox": "._ga",
+    "solve_zigzag": "._baselines", "solve_spiral": "._baselines", "solve_greedy": "._baselines",
+    "PATTERN_VARIANTS": "._baselines",
+})

@@ -1,0 +1,276 @@
+"""The genetic algorithm of Le et al. 2018 for the waypoint order (§4, Algorithm 2) on DEAP, plain or memetic.
+
+Algorithm 2 starts from random orders (population 60), selects parents, produces children, mutates
+them by swapping two random waypoints, *extends* the population with the best children and
+*reduces* it back. Here:
+
+- **individuals** (:class:`~htetro_opt.operators.permutation.Tour`) are permutations of the
+  waypoints other than the start when the start is fixed (so every operator keeps it first), of all
+  waypoints otherwise; the order is ``[start] + genes``;
+- **selection**: tournaments of ``tournament_size``
+  (:func:`~htetro_opt.operators.permutation.select_tournament`);
+- **children**: pairs of winners are crossed with probability ``crossover_rate`` by a linear order
+  crossover (:func:`~htetro_opt.operators.permutation.order_crossover`; the paper leaves crossover
+  out, ``crossover_rate=0`` restores that), then each child is mutated with probability
+  ``mutation_rate`` by the paper's swap (:func:`~htetro_opt.operators.permutation.swap_mutation`);
+- **extend and reduce** (elitist): parents and new children compete for the ``pop_size`` places;
+  an order already in the population takes no second place (unless there are too few distinct
+  ones). ``elite=e`` instead keeps the ``e`` best parents and fills the other places with the best
+  children (a comma strategy with elitism);
+- **stop** after ``max_gen`` generations, after ``patience`` generations without a better best
+  order, or at ``time_limit``.
+
+``memetic=True`` (the ``ga`` method) also improves children by the package's one 2-opt/Or-opt
+local search (:func:`~htetro_opt.solvers.sequencing.improve_batch`'s core: vectorised over the
+children, one best move per child and round) before they compete; ``memetic=False``
+(``ga-plain``) is the paper's GA as above. Neither seeds the population from a heuristic: it starts
+from random orders.
+
+All randomness comes from a private ``random.Random(derive_seed(seed))``: DEAP's own operators
+(``tools.cxOrdered``, ``tools.mutShuffleIndexes``, ``tools.selTournament``) draw from the global
+``random`` module, so this module registers the operators of :mod:`htetro_opt.operators.permutation`,
+which take that generator, on a :class:`deap.base.Toolbox` built per run, and never calls
+``deap.creator``. A run leaves the global ``random`` and ``numpy.random`` states untouched and is
+deterministic for an int seed or a Generator in a given state (unless ``time_limit`` stops it).
+"""
+
+from __future__ import annotations
+
+import math
+import random
+import time
+
+import numpy as np
+from deap import base
+
+from htetro_opt._validation import check_bool, check_int, check_probability, check_time_limit, derive_seed
+from htetro_opt.operators.permutation import Tour, order_crossover, select_tournament, swap_mutation
+from htetro_opt.problems.waypoint_sequencing import path_cost
+from htetro_opt.solvers.sequencing._local import (
+    _check_cost,
+    _improve_rows,
+    _padded_cost,
+    _tolerance,
+)
+
+__all__ = ["make_toolbox", "solve_ga"]
+
+
+def make_toolbox(instance, rng: random.Random, *, tournament_size: int = 3) -> base.Toolbox:
+    """A DEAP toolbox for one instance, every operator drawing from ``rng``.
+
+    Registers ``individual`` (a random :class:`~htetro_opt.operators.permutation.Tour` of the
+    genes), ``population(n)``, ``clone``, ``mate``
+    (:func:`~htetro_opt.operators.permutation.order_crossover`), ``mutate``
+    (:func:`~htetro_opt.operators.permutation.swap_mutation`), ``select(pop, k)``
+    (:func:`~htetro_opt.operators.permutation.select_tournament`), ``orders(tours)`` (full waypoint
+    orders, the start prepended) and ``evaluate(tours)``, which prices every tour of the list with an
+    invalid fitness in one vectorised :func:`~htetro_opt.problems.waypoint_sequencing.path_cost` call
+    and returns how many.
+
+    Examples
+    --------
+    >>> from htetro_opt.problems.waypoint_sequencing import SequencingInstance
+    >>> inst = SequencingInstance(np.abs(np.subtract.outer([0.0, 1, 2], [0.0, 1, 2])), np.zeros((3, 4, 2)), start=1)
+    >>> tb = make_toolbox(inst, random.Random(0))
+    >>> pop = tb.population(2)
+    >>> tb.evaluate(pop), tb.orders(pop).tolist(), [t.fitness.values[0] for t in pop]
+    (2, [[1, 2, 0], [1, 0, 2]], [3.0, 3.0])
+    """
+    cost = np.asarray(instance.cost, dtype=float)
+    start = instance.start
+    genes = [i for i in range(instance.n) if i != start]
+
+    def individual() -> Tour:
+        return Tour(rng.sample(genes, len(genes)))
+
+    def orders(tours) -> np.ndarray:
+        body = np.array([list(t) for t in tours], dtype=np.int64).reshape(len(tours), len(genes))
+        if start is None:
+            return body
+        return np.hstack([np.full((len(body), 1), start, dtype=np.int64), body])
+
+    def evaluate(tours) -> int:
+        fresh = [t for t in tours if not t.fitness.valid]
+        if fresh:
+            for t, c in zip(fresh, np.atleast_1d(path_cost(cost, orders(fresh))).tolist()):
+                t.fitness.values = (c,)
+        return len(fresh)
+
+    toolbox = base.Toolbox()
+    toolbox.register("individual", individual)
+    toolbox.register("population", lambda n: [individual() for _ in range(n)])
+    toolbox.register("clone", Tour.copy)
+    toolbox.register("mate", order_crossover, rng=rng)
+    toolbox.register("mutate", swap_mutation, rng=rng)
+    toolbox.register("select", select_tournament, rng=rng, tournsize=tournament_size)
+    toolbox.register("orders", orders)
+    toolbox.register("evaluate", evaluate)
+    return toolbox
+
+
+# ---------------------------------------------------------------------------------- the solver
+def _cost_of(tour: Tour) -> float:
+    return tour.fitness.values[0]
+
+
+def _distinct(tours) -> tuple[list, list]:
+    """Tours by cost (stable), first occurrences of each order apart from the repeats."""
+    seen, firsts, repeats = set(), [], []
+    for t in sorted(tours, key=_cost_of):
+        key = tuple(t)
+        (repeats if key in seen else firsts).append(t)
+        seen.add(key)
+    return firsts, repeats
+
+
+def _reduce(parents: list, children: list, size: int, elite: int | None) -> list:
+    """Extend the population with the children and reduce it to ``size`` (see the module doc)."""
+    if elite is None:
+        firsts, repeats = _distinct(parents + children)
+        return (firsts + repeats)[:size]
+    keep = sorted(parents, key=_cost_of)[:elite]
+    kept = {tuple(t) for t in keep}
+    firsts, repeats = _distinct([c for c in children if tuple(c) not in kept])
+    rest = sorted(parents, key=_cost_of)[elite:]
+    return (keep + firsts + rest + repeats)[:size]
+
+
+def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool = True,
+             pop_size: int = 60, max_gen: int = 2000, patience: int | None = 200,
+             crossover_rate: float = 0.8, mutation_rate: float = 0.2, tournament_size: int = 3,
+             elite: int | None = None, local_search_rate: float = 0.25,
+             local_search_rounds: int | None = None) -> tuple[np.ndarray, dict]:
+    """Order the waypoints with the paper's GA (Algorithm 2), optionally memetic.
+
+    Parameters
+    ----------
+    instance : SequencingInstance
+        Costs and start (``instance.start`` None: free start).
+    seed : None, int or numpy.random.Generator
+        Source of the run's private ``random.Random`` (seeded by
+        :func:`~htetro_opt._validation.derive_seed`): an int or a Generator reproduces a run, None
+        draws fresh entropy.
+    time_limit : float, optional
+        Wall-clock budget in seconds; checked every generation (and between local-search rounds).
+        None: no limit.
+    memetic : bool
+        Improve children with the 2-opt/Or-opt local search before they compete.
+    pop_size : int
+        μ, the population (60 in the paper); also the number of children per generation.
+    max_gen : int
+        Generation cap.
+    patience : int or None
+        Stop after this many generations without a cheaper best order (None: never).
+    crossover_rate : float
+        Probability that a pair of selected parents is crossed (0: the paper's mutation-only GA).
+    mutation_rate : float
+        Probability that a child gets a swap mutation.
+    tournament_size : int
+        Individuals per selection tournament.
+    elite : int or None
+        None: parents and children compete for every place ((μ+λ) reduction). An integer e: the e
+        best parents survive and the other places go to the best children.
+    local_search_rate : float
+        Memetic only: the share of each generation's new children (the cheapest first) that the
+        local search improves.
+    local_search_rounds : int or None
+        Memetic only: the budget of best-move rounds per local search (None: to the local optimum).
+
+    Returns
+    -------
+    order : ndarray of int64
+        The best order found, starting at ``instance.start`` when it is set.
+    info : dict
+        ``generations``, ``evaluations`` (orders priced, initial population included),
+        ``memetic``, ``best_generation`` (when the best order was found; 0: the initial
+        population) and ``stopped`` (``"max_gen"``, ``"patience"`` or ``"time_limit"``).
+
+    Raises
+    ------
+    ParameterError
+        On an invalid option, e.g. ``pop_size`` below 2 or a rate outside [0, 1].
+
+    Examples
+    --------
+    >>> from htetro_opt.problems.waypoint_sequencing import SequencingInstance
+    >>> x = np.array([0.0, 5, 1, 4, 2, 3])
+    >>> inst = SequencingInstance(np.abs(np.subtract.outer(x, x)), np.zeros((6, 4, 2)), start=0)
+    >>> order, info = solve_ga(inst, seed=1, patience=20)
+    >>> order.tolist(), inst.path_cost(order), info["memetic"]
+    ([0, 2, 4, 5, 3, 1], 5.0, True)
+    >>> order, info = solve_ga(inst, memetic=False, seed=1, patience=50)
+    >>> inst.path_cost(order)
+    5.0
+    """
+    rng = random.Random(derive_seed(seed))
+    time_limit = check_time_limit(time_limit)
+    memetic = check_bool(memetic, "memetic")
+    pop_size = check_int(pop_size, "pop_size", minimum=2)
+    max_gen = check_int(max_gen, "max_gen", minimum=0)
+    patience = check_int(patience, "patience", minimum=1, allow_none=True)
+    crossover_rate = check_probability(crossover_rate, "crossover_rate")
+    mutation_rate = check_probability(mutation_rate, "mutation_rate")
+    tournament_size = check_int(tournament_size, "tournament_size", minimum=1)
+    elite = check_int(elite, "elite", minimum=0, maximum=pop_size, allow_none=True)
+    local_search_rate = check_probability(local_search_rate, "local_search_rate")
+    rounds = check_int(local_search_rounds, "local_search_rounds", minimum=0, allow_none=True)
+    rounds = math.inf if rounds is None else rounds
+    cost = _check_cost(instance.cost)
+
+    began = time.perf_counter()
+    deadline = math.inf if time_limit is None else began + time_limit
+    toolbox = make_toolbox(instance, rng, tournament_size=tournament_size)
+    fixed = instance.start is not None
+    info = {"generations": 0, "evaluations": 0, "memetic": memetic, "best_generation": 0,
+            "stopped": "max_gen"}
+    if instance.n - fixed <= 1:  # nothing to order
+        pop = toolbox.population(1)
+        info["evaluations"] = toolbox.evaluate(pop)
+        return toolbox.orders(pop)[0], info
+
+    padded, tol = _padded_cost(cost), _tolerance(cost)
+
+    def local_search(children: list) -> None:
+        chosen = sorted(children, key=_cost_of)[:math.ceil(local_search_rate * len(children))]
+        if not chosen:
+            return
+        improved = _improve_rows(padded, tol, toolbox.orders(chosen), fixed, rounds=rounds, deadline=deadline)
+        for tour, order, c in zip(chosen, improved, np.atleast_1d(path_cost(cost, improved)).tolist()):
+            tour[:] = order[1:].tolist() if fixed else order.tolist()
+            tour.fitness.values = (c,)
+
+    pop = toolbox.population(pop_size)
+    evaluations = toolbox.evaluate(pop)
+    best = min(pop, key=_cost_of).copy()
+    generation = stale = 0
+    while generation < max_gen:
+        if time.perf_counter() >= deadline:
+            info["stopped"] = "time_limit"
+            break
+        generation += 1
+        offspring = [toolbox.clone(t) for t in toolbox.select(pop, pop_size)]
+        for a, b in zip(offspring[::2], offspring[1::2]):
+            if rng.random() < crossover_rate:
+                toolbox.mate(a, b)
+                del a.fitness.values, b.fitness.values
+        for child in offspring:
+            if rng.random() < mutation_rate:
+                toolbox.mutate(child)
+                del child.fitness.values
+        fresh = [c for c in offspring if not c.fitness.valid]
+        evaluations += toolbox.evaluate(fresh)
+        if memetic:
+            local_search(fresh)
+        pop = _reduce(pop, offspring, pop_size, elite)
+        leader = min(pop, key=_cost_of)
+        if _cost_of(leader) < _cost_of(best) - tol:
+            best, stale = leader.copy(), 0
+            info["best_generation"] = generation
+        else:
+            stale += 1
+            if patience is not None and stale >= patience:
+                info["stopped"] = "patience"
+                break
+    info.update(generations=generation, evaluations=evaluations)
+    return toolbox.orders([best])[0], info

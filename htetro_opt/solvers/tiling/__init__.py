@@ -1,0 +1,16 @@
+"""Tetromino tiling of a grid workspace (Le et al. 2018): :func:`tile_workspace` with ``method=``.
+
+``"backtracking"`` is the paper's search (with region, colouring and memo pruning), ``"cpsat"`` an
+exact cover by OR-Tools' CP-SAT. :func:`enumerate_tilings` lists several tilings and
+:func:`find_tiles` returns the bare tiles; a map that cannot be tiled raises a
+:class:`~htetro_opt.errors.TilingError` that says why.
+
+Importing this package imports neither pymoo nor DEAP.
+"""
+
+from htetro_opt._lazy import attach
+
+__getattr__, __dir__, __all__ = attach(__name__, {
+    "tile_workspace": "._tiling", "enumerate_tilings": "._tiling", "find_tiles": "._tiling",
+    "TILING_METHODS": "._tiling",
+})

@@ -1,0 +1,863 @@
+"""Tiling a grid workspace with tetrominoes: the first phase of Le et al. 2018 (§3.1, Fig. 5).
+
+The free cells of a workspace are covered exactly once by tetrominoes of the allowed morphologies
+(all seven by default; the paper's Fig. 12c uses only Z and T, its Fig. 16c only O). Each tile then
+becomes a waypoint: :func:`tile_workspace` hands the tiles to Algorithm 1
+(:func:`~htetro_opt.problems.waypoint_sequencing.block_locations`), which numbers them in scan order
+and labels their blocks a–d with a robot footprint.
+
+Pre-checks
+    Before any search both methods test the same necessary conditions, each failing with a
+    :class:`~htetro_opt.errors.TilingError` that names what is wrong and where: a free cell exists;
+    the free area is a multiple of 4; so is the area of every 4-connected region of free cells (a
+    region of fewer than four cells is isolated); the colourings of tiling theory hold in every
+    region — without T each tetromino covers 2 black and 2 white cells of a checkerboard (so the
+    counts must be equal), T alone covers 3 + 1, L and J cover an odd number of cells of the even
+    columns (and rows), I, O, S and Z an even one, and more generally the region's cell counts by
+    ``(x mod 4, y mod 4)`` must be an integer combination of the allowed placements' counts (an
+    integer-lattice test); and every free cell lies under some placement of an allowed shape.
+    They are sound (never reject a tileable map) and catch most untileable maps at once.
+
+``"backtracking"``, the paper's algorithm (its ref. 38, the classic polyomino tiling backtracker)
+    Take the first uncovered free cell in scan order (top row first, then left to right), try each
+    allowed fixed tetromino anchored there (the pattern's first cell in scan order on that cell, so
+    it covers nothing before it), and go on; when no pattern fits, undo the previous placement and
+    try its next pattern. The search is an explicit stack, not recursion (a 64 × 64 grid is 1024
+    levels deep), on a padded flat byte grid, so that a placement test is three look-ups. It is
+    complete (when it ends without a tiling, none exists) and pruned three ways:
+
+    - after each placement, a flood fill from the uncovered cells next to the new tile; a region
+      that is enclosed (the fill ends before reaching the rows 4 below the anchor, where no tile
+      lies yet, or before :data:`EXACT_LIMIT` cells when it does reach them) must have an area that
+      is a multiple of 4, equal checkerboard colours without T, and must tile on its own: a
+      search of that region alone, turned so that it runs along the region's long side, cached by
+      the region's shape;
+    - everything before the anchor is covered and no tile reaches more than 3 rows below its
+      anchor, so the anchor and the next ``3 W + 1`` cells are the whole state of the search: a
+      state whose subtree held no tiling is remembered (as a 128-bit digest, up to
+      :data:`MEMO_LIMIT` of them) and never searched again;
+    - the pre-checks above.
+
+    With ``shuffle=True`` the pattern order is shuffled once by the ``seed``'s generator (other
+    tilings); without it the order is that of :data:`~htetro_opt.model.tiles.PATTERNS` (I, O, L, J,
+    Z, S, T), which tiles a grid whose height is a multiple of 4 by vertical I's without a single
+    backtrack. It tiles 64 × 64 grids, free or with scattered obstacle blocks, in well under a
+    second; on cluttered maps with few allowed shapes (T with Z or I, say) it can still search for
+    long, which is what ``time_limit`` and CP-SAT are for.
+
+``"cpsat"``, OR-Tools CP-SAT on the exact-cover model
+    One Boolean per placement (allowed pattern × anchor, all four cells free) and ``AddExactlyOne``
+    over the placements covering each free cell. The placements are declared, in the backtracker's
+    order, as a decision strategy, and CP-SAT's portfolio search takes turns between it and its own
+    heuristics, with propagation and clause learning. Presolve, probing, symmetry detection and
+    inprocessing are off: on 24 × 24 to 64 × 64 grids they cost seconds and find nothing. It runs
+    on one worker with a ``random_seed`` (0, or drawn from ``seed`` with ``shuffle=True``) and the
+    pattern order, so a seed gives one tiling, reproducibly, and other seeds others. It takes a few
+    seconds on 64 × 64 grids and proves untileability where the backtracker would search for long.
+
+Overlapping sub-workspaces (§3.1, Fig. 5d–f)
+    "If the size of the coverage area is not a multiple of hTetro blocks, we can segment this
+    workspace into two partially overlapping sub-workspaces and both can be tiled." The paper gives
+    no rule for the segmentation; ours: with ``overlap=True``, a map that does not tile as it is
+    (a pre-check fails or no tiling exists) is split into two bands of rows, ``y < k2`` and
+    ``y >= k1`` with ``1 <= k1 < k2 <= H - 1`` (so that both are proper sub-grids, sharing rows
+    ``k1 … k2 − 1``), or two bands of columns likewise, whose free cells both tile; the split with
+    the fewest shared free cells wins, ties going to rows before columns, then to the smaller
+    ``k1`` (then ``k2``). Both bands' tiles are kept, so the shared cells are covered twice
+    (:meth:`~htetro_opt.scenarios.tileset.Tileset.coverage` is 2 there): a free grid 6 wide and 7
+    high (area 42) splits into rows 0–1 and rows 1–6, 12 tiles covering its 42 cells with the 6
+    cells of row 1 covered twice.
+
+Examples
+--------
+>>> tile_workspace(np.zeros((2, 4), dtype=bool)).shapes
+('I', 'I')
+>>> ts = tile_workspace(np.zeros((2, 4), dtype=bool), shapes="O")
+>>> ts.ids, ts.shapes, ts.complete
+((1, 2), ('O', 'O'), True)
+"""
+
+from __future__ import annotations
+
+import functools
+import time as _time
+from hashlib import blake2b
+
+import numpy as np
+from scipy import ndimage
+
+from htetro_opt._interrupt import on_signal
+from htetro_opt._validation import check_bool, check_int, check_seed, check_time_limit, derive_seed
+from htetro_opt.errors import ParameterError, TilingError
+from htetro_opt.model.tiles import Pattern, patterns_of
+from htetro_opt.model.workspace import Workspace
+from htetro_opt.problems.waypoint_sequencing import (
+    DEFAULT_BLOCK_WEIGHTS,
+    block_locations,
+    check_weights,
+)
+from htetro_opt.scenarios.tileset import Tileset
+
+__all__ = [
+    "EXACT_LIMIT",
+    "FLOOD_LIMIT",
+    "MEMO_LIMIT",
+    "TILING_METHODS",
+    "enumerate_tilings",
+    "find_tiles",
+    "tile_workspace",
+]
+
+TILING_METHODS = ("backtracking", "cpsat")
+"""The tiling methods: the paper's backtracking search and OR-Tools CP-SAT."""
+
+FLOOD_LIMIT = 4096
+"""Most cells the backtracker's pruning flood fill visits before it treats a region as open."""
+
+EXACT_LIMIT = 64
+"""Regions of uncovered cells up to this size are checked exactly (a search of the region alone)
+whenever a placement encloses them, however far they reach."""
+
+MEMO_LIMIT = 1_000_000
+"""Most failed search states the backtracker remembers (a 16-byte digest each, ~0.1 GB at the limit)."""
+
+_PAD = 3  # a pattern reaches at most 3 cells from its anchor in x and y
+_CHECK_EVERY = 2048  # search steps between two looks at the clock
+
+
+class _TimeLimit(TilingError):
+    """The time limit ran out (the map may still be tileable): never a reason to try a split."""
+
+
+# ------------------------------------------------------------------------------------------------
+# Validation
+
+
+def _as_occupancy(workspace) -> tuple[np.ndarray, float]:
+    if isinstance(workspace, Workspace):
+        return workspace.occupancy, workspace.cell_size
+    try:
+        occ = np.asarray(workspace)
+    except (TypeError, ValueError) as err:
+        raise ParameterError(
+            f"the workspace must be a Workspace or an (H, W) bool array, got {type(workspace).__name__}"
+        ) from err
+    if occ.ndim != 2 or 0 in occ.shape:
+        raise ParameterError(f"the occupancy must be a non-empty 2-D (H, W) array, got shape {occ.shape}")
+    if occ.dtype != bool:
+        if not np.issubdtype(occ.dtype, np.number) or not np.isin(occ, (0, 1)).all():
+            raise ParameterError("the occupancy must hold booleans (True = obstacle) or 0/1")
+        occ = occ.astype(bool)
+    return occ, 1.0
+
+
+def _check_shapes(shapes) -> tuple[Pattern, ...]:
+    if shapes is not None:
+        try:
+            names = list(shapes)  # "TZ" -> ["T", "Z"]
+        except TypeError as err:
+            raise ParameterError(f"shapes must be morphology names such as 'TZ' or ['O'], got {shapes!r}") from err
+        if not names:
+            raise ParameterError("shapes is empty: allow at least one morphology (I, O, L, J, Z, S, T)")
+        shapes = names
+    return patterns_of(shapes)
+
+
+def _check_options(method, shuffle, seed, time_limit) -> tuple[int | None, float | None]:
+    """The search's order seed (None: the fixed order) and its deadline, all options checked (the
+    seed too when ``shuffle`` is off and it goes unused: a bad value is a mistake either way)."""
+    if method not in TILING_METHODS:
+        raise ParameterError(f"unknown tiling method {method!r}: expected one of {', '.join(TILING_METHODS)}")
+    seed = check_seed(seed)
+    order_seed = derive_seed(seed) if check_bool(shuffle, "shuffle") else None
+    time_limit = check_time_limit(time_limit)
+    return order_seed, None if time_limit is None else _time.perf_counter() + time_limit
+
+
+# ------------------------------------------------------------------------------------------------
+# Placements and pre-checks
+
+
+def _placements(free: np.ndarray, patterns) -> tuple[np.ndarray, np.ndarray]:
+    """Every placement of the patterns on free cells: (pattern index per placement, cells (n, 4, 2))."""
+    h, w = free.shape
+    padded = np.zeros((h + 2 * _PAD, w + 2 * _PAD), dtype=bool)
+    padded[_PAD:_PAD + h, _PAD:_PAD + w] = free
+    which, cells = [], []
+    for k, pattern in enumerate(patterns):
+        ok = free.copy()
+        for dx, dy in pattern.cells[1:].tolist():
+            ok &= padded[_PAD + dy:_PAD + dy + h, _PAD + dx:_PAD + dx + w]
+        ys, xs = np.nonzero(ok)
+        if len(xs):
+            anchor = np.stack([xs, ys], axis=1)
+            cells.append(anchor[:, None, :] + pattern.cells[None, :, :])
+            which.append(np.full(len(xs), k, dtype=np.int64))
+    if not cells:
+        return np.zeros(0, dtype=np.int64), np.zeros((0, 4, 2), dtype=np.int64)
+    return np.concatenate(which), np.concatenate(cells).astype(np.int64)
+
+
+def _shape_text(patterns) -> str:
+    return "".join(s for s in "IOLJZST" if s in {p.shape for p in patterns})
+
+
+def _cell_text(x, y) -> str:
+    return f"({int(x)}, {int(y)})"
+
+
+def _first_in_scan(mask: np.ndarray) -> tuple[int, int]:
+    ys, xs = np.nonzero(mask)
+    i = np.lexsort((xs, -ys))[0]
+    return int(xs[i]), int(ys[i])
+
+
+def _colour_rules(patterns) -> tuple:
+    """What the colourings prove for this set of patterns.
+
+    Returns (checkerboard, columns, rows): checkerboard is "equal" (every pattern covers 2 black and
+    2 white cells: all but T), "T" (every pattern covers 3 of one colour and 1 of the other: T alone)
+    or None; columns / rows are "odd" (every pattern covers an odd number of cells in even columns /
+    rows: L and J), "even" (I, O, S, Z) or None (mixed; T has both).
+    """
+    diffs = {abs(int(((p.cells.sum(axis=1) % 2) == 0).sum()) * 2 - 4) for p in patterns}
+    board = "equal" if diffs == {0} else "T" if diffs == {2} else None
+    stripes = []
+    for axis in (0, 1):
+        parities = {int((p.cells[:, axis] % 2 == 0).sum()) % 2 for p in patterns}
+        stripes.append("odd" if parities == {1} else "even" if parities == {0} else None)
+    return (board, *stripes)
+
+
+_PERIOD = 4  # cells are counted by (x mod 4, y mod 4): 16 classes
+
+
+@functools.cache
+def _class_lattice(shapes: str) -> tuple:
+    """An echelon basis (over the integers) of the class counts that tilings by these shapes can have.
+
+    A placement of a pattern adds one to the class of each of its cells; whatever the tiling, a
+    region's class counts are a sum of such vectors, so they must lie in the lattice the vectors
+    span (the colouring arguments of tiling theory, checkerboards and stripes among them).
+    Returns (pivot column, row) pairs, rows as tuples of Python ints.
+    """
+    m = _PERIOD
+    rows = []
+    for pattern in patterns_of(shapes):
+        for ax in range(m):
+            for ay in range(m):
+                v = [0] * (m * m)
+                for dx, dy in pattern.cells.tolist():
+                    v[((ax + dx) % m) * m + (ay + dy) % m] += 1
+                rows.append(v)
+    basis = []
+    for col in range(m * m):
+        live = [r for r in rows if r[col]]
+        rows = [r for r in rows if not r[col]]
+        while len(live) > 1:  # Euclid on the column
+            live.sort(key=lambda r: abs(r[col]))
+            pivot, rest = live[0], []
+            for r in live[1:]:
+                q = r[col] // pivot[col]
+                r = [a - q * b for a, b in zip(r, pivot)]
+                (rest if r[col] else rows).append(r)
+            live = [pivot] + rest
+        if live:
+            pivot = live[0] if live[0][col] > 0 else [-a for a in live[0]]
+            basis.append((col, tuple(pivot)))
+        rows = [r for r in rows if any(r)]
+    return tuple(basis)
+
+
+def _class_counts(xs, ys) -> list[int]:
+    counts = np.bincount((np.asarray(xs) % _PERIOD) * _PERIOD + np.asarray(ys) % _PERIOD, minlength=_PERIOD ** 2)
+    return [int(c) for c in counts]
+
+
+def _in_lattice(basis, counts) -> bool:
+    t = list(counts)
+    for col, row in basis:
+        q, r = divmod(t[col], row[col])
+        if r:
+            return False
+        if q:
+            t = [a - q * b for a, b in zip(t, row)]
+    return not any(t)
+
+
+def _violation(occ: np.ndarray, patterns) -> str | None:
+    """The first necessary condition for a tiling that the free cells fail, as a message, or None."""
+    free = ~occ
+    allowed = _shape_text(patterns)
+    n_free = int(free.sum())
+    if n_free == 0:
+        return "the workspace has no free cell to tile"
+    if n_free % 4:
+        return (f"the free area is {n_free} cells, not a multiple of 4: no tetromino tiling covers it "
+                "exactly (the overlap option, --overlap on the command line, covers it by two overlapping sub-workspaces)")
+    labels, n = ndimage.label(free)  # 4-connected
+    ys, xs = np.nonzero(free)
+    scan = np.lexsort((xs, -ys))
+    ids, first = np.unique(labels[ys[scan], xs[scan]], return_index=True)
+    # each region named by its first cell in scan order, the regions in that order
+    regions = sorted(((int(xs[scan[j]]), int(ys[scan[j]])), int(i)) for i, j in zip(ids, first))
+    regions.sort(key=lambda r: (-r[0][1], r[0][0]))
+    sizes = np.bincount(labels.ravel(), minlength=n + 1)
+    for (x, y), i in regions:
+        size = int(sizes[i])
+        if size % 4 and size < 4:
+            return (f"the region around cell {_cell_text(x, y)} has {size} free cell{'s' if size > 1 else ''}, "
+                    "isolated and too small for a tetromino")
+        if size % 4:
+            return f"the region around cell {_cell_text(x, y)} has {size} free cells, not a multiple of 4"
+    board, columns, rows = _colour_rules(patterns)
+    for (x, y), i in regions:
+        inside = labels[ys, xs] == i
+        what = "the free cells" if n == 1 else f"the region around cell {_cell_text(x, y)}"
+        tiles = int(sizes[i]) // 4
+        black = int((((xs + ys) % 2 == 0) & inside).sum())
+        white = int(sizes[i]) - black
+        if board == "equal" and black != white:
+            return (f"{what} hold {black} black and {white} white cells of a checkerboard; every tetromino but T "
+                    f"covers 2 of each, so without T ({allowed} allowed) they must be equal")
+        if board == "T" and (abs(black - white) // 2 - tiles) % 2:
+            return (f"{what} hold {black} black and {white} white cells of a checkerboard; each T covers 3 of one "
+                    f"colour and 1 of the other, so {tiles} T tiles need (black - white) / 2 to be "
+                    f"{'odd' if tiles % 2 else 'even'}")
+        for rule, coords, line in ((columns, xs, "column"), (rows, ys, "row")):
+            even = int(((coords % 2 == 0) & inside).sum())
+            if rule == "odd" and (even - tiles) % 2:
+                return (f"{what} hold {even} cells in even {line}s; every allowed tetromino ({allowed}) covers an "
+                        f"odd number of them, so {tiles} tiles need an {'odd' if tiles % 2 else 'even'} count")
+            if rule == "even" and even % 2:
+                return (f"{what} hold {even} cells in even {line}s; every allowed tetromino ({allowed}) covers an "
+                        "even number of them, so the count must be even")
+        if not _in_lattice(_class_lattice(allowed), _class_counts(xs[inside], ys[inside])):
+            return (f"{what} cannot be tiled by {allowed}: counting its cells by (x mod 4, y mod 4) gives "
+                    f"16 counts that no set of {allowed} tiles adds up to")
+    _, cells = _placements(free, patterns)
+    covered = np.zeros_like(free)
+    covered[cells[..., 1].ravel(), cells[..., 0].ravel()] = True
+    stuck = free & ~covered
+    if stuck.any():
+        x, y = _first_in_scan(stuck)
+        more = int(stuck.sum()) - 1
+        return (f"no tile of the allowed shapes ({allowed}) fits over cell {_cell_text(x, y)}"
+                f"{f' (nor over {more} more cells)' if more else ''}")
+    return None
+
+
+def _precheck(occ: np.ndarray, patterns) -> None:
+    """The necessary conditions every method checks first; TilingError naming the first that fails."""
+    problem = _violation(occ, patterns)
+    if problem is not None:
+        raise TilingError(problem)
+
+
+# ------------------------------------------------------------------------------------------------
+# Backtracking
+
+
+def _backtrack(occ: np.ndarray, patterns, order, deadline, cache: dict):
+    """Generate the tilings of the free cells as lists of (anchor index, position in ``order``),
+    depth first. ``cache`` maps enclosed regions (normalised) to whether they tile; share it."""
+    h, w = occ.shape
+    stride = w + 2 * _PAD
+    rows = h + 2 * _PAD
+    size = stride * rows
+    # internal row r = (h - 1 - y) + PAD, so increasing flat index is the scan order
+    padded = np.ones((rows, stride), dtype=np.uint8)
+    padded[_PAD:_PAD + h, _PAD:_PAD + w] = occ[::-1]
+    filled = bytearray(padded.tobytes())
+    colour = (np.add.outer(np.arange(rows), np.arange(stride)) & 1).astype(np.uint8).tobytes()
+    offsets = [tuple(int(dx) - int(dy) * stride for dx, dy in patterns[k].cells[1:].tolist()) for k in order]
+    n_pat = len(offsets)
+    check_parity = "T" not in {p.shape for p in patterns}
+    lattice = _class_lattice(_shape_text(patterns))
+    exact, limit = EXACT_LIMIT, FLOOD_LIMIT
+    neighbours = (1, -1, stride, -stride)
+
+    def enclosed_ok(cells: tuple, far_from: int) -> bool:
+        """False if an enclosed uncovered region next to the new tile cannot be tiled.
+
+        A flood fill from each uncovered neighbour of the tile; it gives up (the region is open) on
+        joining a region found open before, past ``exact`` cells when it has reached ``far_from``
+        (rows no tile reaches yet), or past ``limit`` cells.
+        """
+        open_cells: set = set()
+        closed_cells: set = set()
+        for cell in cells:
+            for d in neighbours:
+                start = cell + d
+                if filled[start] or start in open_cells or start in closed_cells:
+                    continue
+                local = {start}
+                stack = [start]
+                balance = 0
+                far = opened = False
+                while stack:
+                    c = stack.pop()
+                    if c >= far_from:
+                        far = True
+                    balance += 1 if colour[c] else -1
+                    for e in neighbours:
+                        n = c + e
+                        if filled[n] or n in local:
+                            continue
+                        if n in open_cells:
+                            opened = True
+                            break
+                        local.add(n)
+                        stack.append(n)
+                    if opened or len(local) > limit or (far and len(local) > exact):
+                        opened = True
+                        break
+                if opened:
+                    open_cells |= local
+                elif len(local) % 4 or (check_parity and balance) or not region_tiles(local):
+                    return False
+                else:
+                    closed_cells |= local
+        return True
+
+    def region_tiles(region: set) -> bool:
+        """Whether an enclosed region tiles on its own: a search of the region alone, turned to
+        run along its long side (so its memo stays small), cached by shape."""
+        rc = [divmod(c, stride) for c in region]
+        r0 = min(r for r, _ in rc)
+        c0 = min(c for _, c in rc)
+        small = np.ones((max(r for r, _ in rc) - r0 + 1, max(c for _, c in rc) - c0 + 1), dtype=bool)
+        for r, c in rc:
+            small[r - r0, c - c0] = False
+        small = small[::-1]  # internal rows run downwards; occupancy rows upwards
+        if small.shape[1] > small.shape[0]:
+            small = np.rot90(small)  # a rotation maps each tetromino to one of its own shape
+        key = (small.shape, small.tobytes())
+        known = cache.get(key)
+        if known is None:
+            if deadline is not None and _time.perf_counter() > deadline:
+                raise _TimeLimit("time limit")
+            ys, xs = np.nonzero(~small)
+            known = _in_lattice(lattice, _class_counts(xs, ys))
+            if known:
+                search = _backtrack(np.ascontiguousarray(small), patterns, order, deadline, cache)
+                try:
+                    known = next(search, None) is not None
+                finally:
+                    search.close()
+            cache[key] = known
+        return known
+
+    # Everything before the anchor is covered and no tile reaches 3 rows past its anchor, so the
+    # anchor and the cells [anchor, anchor + window) are the whole search state: a state whose
+    # subtree held no tiling is remembered (as a 128-bit digest) and never searched again.
+    window = 3 * stride + 1
+    failed: set[bytes] = set()
+
+    def state(at: int) -> bytes:
+        return blake2b(filled[at:at + window], digest_size=16, salt=at.to_bytes(8, "little")).digest()
+
+    first = 0
+    while first < size and filled[first]:
+        first += 1
+    if first == size:
+        return
+    anchors: list[int] = []
+    chosen: list[int] = []
+    entered = [0]  # tilings found when each open level was entered
+    found = 0
+    anchor, k = first, 0
+    steps = 0
+    while True:
+        if deadline is not None and steps % _CHECK_EVERY == 0 and _time.perf_counter() > deadline:
+            raise _TimeLimit("time limit")
+        steps += 1
+        placed = False
+        while k < n_pat:
+            o1, o2, o3 = offsets[k]
+            if not (filled[anchor + o1] or filled[anchor + o2] or filled[anchor + o3]):
+                cells = (anchor, anchor + o1, anchor + o2, anchor + o3)
+                for c in cells:
+                    filled[c] = 1
+                # no tile reaches 4 rows below the anchor's row: a fill that gets there is open
+                if enclosed_ok(cells, (anchor // stride + 4) * stride):
+                    nxt = anchor + 1
+                    while nxt < size and filled[nxt]:
+                        nxt += 1
+                    if nxt == size:
+                        found += 1
+                        yield [(a, c) for a, c in zip(anchors + [anchor], chosen + [k])]
+                    elif state(nxt) not in failed:
+                        placed = True
+                        break
+                for c in cells:
+                    filled[c] = 0
+            k += 1
+        if placed:
+            anchors.append(anchor)
+            chosen.append(k)
+            entered.append(found)
+            anchor, k = nxt, 0
+            continue
+        # every pattern at this anchor failed: remember the state if it held no tiling, backtrack
+        if entered.pop() == found and len(failed) < MEMO_LIMIT:
+            failed.add(state(anchor))
+        if not anchors:
+            return
+        anchor, k = anchors.pop(), chosen.pop()
+        o1, o2, o3 = offsets[k]
+        for c in (anchor, anchor + o1, anchor + o2, anchor + o3):
+            filled[c] = 0
+        k += 1
+
+
+def _backtracking_tilings(occ, patterns, seed, deadline):
+    h, w = occ.shape
+    stride = w + 2 * _PAD
+    order = _pattern_order(len(patterns), seed)
+    for solution in _backtrack(occ, patterns, order, deadline, {}):
+        tiles = []
+        for anchor, k in solution:
+            r, c = divmod(anchor, stride)
+            x, y = c - _PAD, h - 1 - (r - _PAD)
+            tiles.append(np.array([x, y], dtype=np.int64) + patterns[order[k]].cells)
+        yield tiles
+
+
+# ------------------------------------------------------------------------------------------------
+# CP-SAT
+
+
+def _pattern_order(n: int, seed) -> list[int]:
+    """The order patterns are tried in: as given, or shuffled by the seed."""
+    if seed is None:
+        return list(range(n))
+    return np.random.default_rng(seed).permutation(n).tolist()
+
+
+def _cpsat_tilings(occ, patterns, seed, deadline, limit):
+    """Up to ``limit`` tilings by CP-SAT; [] when infeasible; _TimeLimit when out of time with none."""
+    from ortools.sat.python import cp_model
+
+    free = ~occ
+    which, cells = _placements(free, patterns)
+    # placements in search order: anchor (cells[:, 0]) in scan order, then the seed's pattern order
+    rank = np.empty(len(patterns), dtype=np.int64)
+    rank[_pattern_order(len(patterns), seed)] = np.arange(len(patterns))
+    by = np.lexsort((rank[which], cells[:, 0, 0], -cells[:, 0, 1]))
+    cells = cells[by]
+    model = cp_model.CpModel()
+    xs = [model.NewBoolVar("") for _ in range(len(cells))]
+    h, w = occ.shape
+    flat = (cells[..., 1] * w + cells[..., 0]).ravel()
+    owner = np.repeat(np.arange(len(cells)), 4)
+    by_cell = np.argsort(flat, kind="stable")
+    bounds = np.searchsorted(flat[by_cell], np.arange(h * w + 1))
+    owner = owner[by_cell].tolist()
+    for c in np.flatnonzero(free.ravel()).tolist():
+        model.AddExactlyOne([xs[i] for i in owner[bounds[c]:bounds[c + 1]]])
+    # The backtracker's order, declared as a search strategy: CP-SAT's portfolio (one worker) takes
+    # turns between it and its own heuristics at each restart, with propagation and clause learning.
+    model.AddDecisionStrategy(xs, cp_model.CHOOSE_FIRST, cp_model.SELECT_MAX_VALUE)
+
+    solver = cp_model.CpSolver()
+    params = solver.parameters
+    params.catch_sigint_signal = False  # Ctrl-C goes to Python (see htetro_opt._interrupt), not CP-SAT
+    params.num_workers = 1  # one worker: the search, hence the tiling, is reproducible
+    params.random_seed = 0 if seed is None else int(seed)
+    params.search_branching = cp_model.PORTFOLIO_SEARCH
+    # measured on 24 x 24 to 64 x 64 grids: presolve, probing and inprocessing cost seconds and
+    # find nothing on an exact cover; the fixed search alone stalls on some maps (h_shape)
+    params.cp_model_presolve = False
+    params.cp_model_probing_level = 0
+    params.linearization_level = 0
+    params.symmetry_level = 0
+    params.use_sat_inprocessing = False
+    if deadline is not None:
+        left = deadline - _time.perf_counter()
+        if left <= 0:
+            raise _TimeLimit("time limit")
+        params.max_time_in_seconds = left
+
+    found: list[list[np.ndarray]] = []
+
+    def record(values) -> None:
+        chosen = np.flatnonzero(np.asarray(values, dtype=np.int64)[:len(cells)])
+        found.append([cells[i].copy() for i in chosen.tolist()])
+
+    class _Collect(cp_model.CpSolverSolutionCallback):
+        def on_solution_callback(self):  # OR-Tools' hook
+            record(self.response_proto.solution)
+            if len(found) >= limit:
+                self.StopSearch()
+
+    if limit > 1:
+        params.enumerate_all_solutions = True
+        with on_signal(solver.StopSearch):  # Ctrl-C stops CP-SAT now, not at its time limit
+            status = solver.Solve(model, _Collect())
+    else:
+        with on_signal(solver.StopSearch):
+            status = solver.Solve(model)
+        if status in (cp_model.OPTIMAL, cp_model.FEASIBLE):
+            record(solver.response_proto.solution)
+    if found:
+        return found
+    if status == cp_model.INFEASIBLE:
+        return []
+    if status == cp_model.UNKNOWN:
+        raise _TimeLimit("time limit")
+    raise TilingError(f"CP-SAT ended with status {solver.StatusName(status)} on the tiling model")
+
+
+# ------------------------------------------------------------------------------------------------
+# Drivers
+
+
+def _time_message(method, time_limit) -> str:
+    if method == "backtracking":
+        return (f"the backtracking search found no tiling within the time limit of {time_limit:g} s; "
+                "try --method cpsat (method='cpsat') or a longer time limit")
+    return f"CP-SAT found no tiling within the time limit of {time_limit:g} s; try a longer time limit"
+
+
+def _tilings(occ, patterns, method, seed, deadline, limit):
+    """Pre-checks, then up to ``limit`` tilings (non-empty list) or TilingError / _TimeLimit."""
+    _precheck(occ, patterns)
+    if method == "backtracking":
+        found = []
+        generator = _backtracking_tilings(occ, patterns, seed, deadline)
+        try:
+            for tiles in generator:
+                found.append(tiles)
+                if len(found) >= limit:
+                    break
+        except _TimeLimit:
+            if not found:
+                raise
+        finally:
+            generator.close()
+    else:
+        found = _cpsat_tilings(occ, patterns, seed, deadline, limit)
+    if not found:
+        raise TilingError(
+            f"no tiling of the {int((~occ).sum())} free cells by {_shape_text(patterns)} tetrominoes exists "
+            f"(the {method} search is exhaustive)"
+        )
+    return found
+
+
+def _retime(method, time_limit) -> TilingError:
+    """The error the caller sees when the time limit ran out."""
+    return TilingError(_time_message(method, time_limit))
+
+
+def find_tiles(occupancy, *, shapes=None, method: str = "backtracking", shuffle: bool = False, seed=None,
+               time_limit: float | None = None) -> list[np.ndarray]:
+    """An exact cover of the free cells by tetrominoes of the allowed shapes.
+
+    Parameters
+    ----------
+    occupancy : ndarray of bool, shape (H, W), or Workspace
+        ``occ[y, x]``, True for an obstacle.
+    shapes : iterable of str, optional
+        The allowed morphologies, e.g. ``"TZ"`` or ``["O"]``; all seven when None.
+    method : {"backtracking", "cpsat"}
+        The paper's backtracking search or CP-SAT (see the module docstring).
+    shuffle : bool
+        False (default): the fixed pattern order, one tiling per map, ``seed`` unused. True: the
+        pattern order (and CP-SAT's random seed) drawn from ``seed``, for another tiling.
+    seed : None, int or numpy.random.Generator
+        With ``shuffle``: an int or a Generator gives the same tiling every time, None a fresh one.
+    time_limit : float, optional
+        Seconds the search may take; no limit when None.
+
+    Returns
+    -------
+    list of ndarray of int, shape (4, 2)
+        The cells ``(x, y)`` of each tile, the tiles in scan order of their first cell.
+
+    Raises
+    ------
+    TilingError
+        If a pre-check fails (no free cell; free area, or a 4-connected region's area, not a multiple
+        of 4; unequal checkerboard colours without T; a cell no allowed tile fits over), if no tiling
+        exists, or if the time limit runs out first.
+    UnknownShapeError
+        If a shape name is unknown.
+    ParameterError
+        If ``shapes`` is empty, or ``method``, ``seed`` or ``time_limit`` is invalid.
+
+    Examples
+    --------
+    >>> tiles = find_tiles(np.zeros((4, 2), dtype=bool), shapes="O")
+    >>> [t.tolist() for t in tiles]
+    [[[0, 3], [1, 3], [0, 2], [1, 2]], [[0, 1], [1, 1], [0, 0], [1, 0]]]
+    """
+    occ, _ = _as_occupancy(occupancy)
+    patterns = _check_shapes(shapes)
+    seed, deadline = _check_options(method, shuffle, seed, time_limit)
+    try:
+        return _tilings(occ, patterns, method, seed, deadline, 1)[0]
+    except _TimeLimit as err:
+        raise _retime(method, time_limit) from err
+
+
+def _band_splits(occ: np.ndarray):
+    """Candidate splits into two overlapping bands, best first: (shared free cells, axis, k1, k2).
+
+    Axis 0 splits rows (bands ``y < k2`` and ``y >= k1``), axis 1 columns; ``1 <= k1 < k2 <= n - 1``
+    so that both bands are proper, and both bands' free areas are multiples of 4.
+    """
+    free = ~occ
+    out = []
+    for axis in (0, 1):
+        per_line = free.sum(axis=1 - axis)
+        before = np.concatenate([[0], np.cumsum(per_line)])  # free cells in lines < k
+        n, total = len(per_line), int(before[-1])
+        for k1 in range(1, n - 1):
+            for k2 in range(k1 + 1, n):
+                area_a, area_b = int(before[k2]), total - int(before[k1])
+                if area_a % 4 == 0 and area_b % 4 == 0:
+                    out.append((int(before[k2] - before[k1]), axis, k1, k2))
+    out.sort()
+    return out
+
+
+def _band(occ: np.ndarray, axis: int, lo: int, hi: int) -> np.ndarray:
+    """The occupancy of the lines lo <= k < hi alone (every other line an obstacle)."""
+    band = np.ones_like(occ)
+    if axis == 0:
+        band[lo:hi] = occ[lo:hi]
+    else:
+        band[:, lo:hi] = occ[:, lo:hi]
+    return band
+
+
+def _overlapping_tiles(occ, patterns, method, seed, deadline, cause):
+    """The tiles of the best split whose two bands both tile (see :func:`tile_workspace`)."""
+    for _shared, axis, k1, k2 in _band_splits(occ):
+        if deadline is not None and _time.perf_counter() > deadline:
+            raise _TimeLimit("time limit")
+        n = occ.shape[axis]
+        band_a, band_b = _band(occ, axis, 0, k2), _band(occ, axis, k1, n)
+        if _violation(band_a, patterns) is not None or _violation(band_b, patterns) is not None:
+            continue
+        try:
+            tiles_a = _tilings(band_a, patterns, method, seed, deadline, 1)[0]
+            tiles_b = _tilings(band_b, patterns, method, seed, deadline, 1)[0]
+        except _TimeLimit:
+            raise
+        except TilingError:
+            continue
+        return tiles_a + tiles_b
+    raise TilingError(
+        f"{cause}; nor does any split of the grid into two overlapping bands of rows or of columns "
+        "have both bands tileable"
+    ) from cause
+
+
+def tile_workspace(workspace, *, shapes=None, method: str = "backtracking", shuffle: bool = False, seed=None,
+                   time_limit: float | None = None, overlap: bool = False, weights=DEFAULT_BLOCK_WEIGHTS,
+                   name: str = "") -> Tileset:
+    """Tile a workspace and label the tiles by Algorithm 1: the waypoints of Le et al. 2018.
+
+    Parameters
+    ----------
+    workspace : Workspace or ndarray of bool, shape (H, W)
+        The map (``occ[y, x]`` True for an obstacle).
+    shapes, method, shuffle, seed, time_limit
+        As in :func:`find_tiles`; the time limit covers the whole call, splits included.
+    overlap : bool
+        When the free cells do not tile as they are, split the grid into two overlapping bands of
+        rows (``y < k2`` and ``y >= k1``) or of columns whose free cells both tile, the split with
+        the fewest shared free cells first (ties: rows before columns, then smaller ``k1``), and keep
+        the tiles of both: the shared cells are covered twice (Le et al. 2018, §3.1, Fig. 5d–f). A
+        map that tiles as it is is tiled normally.
+    weights : sequence of 4 float
+        α, β, λ, γ of eq. 2, for Algorithm 1's choice among a symmetric tile's options.
+    name : str
+        The tileset's name.
+
+    Returns
+    -------
+    Tileset
+        Tiles numbered 1, 2, … in scan order, each labelled by a robot footprint.
+
+    Raises
+    ------
+    TilingError
+        As :func:`find_tiles`; with ``overlap``, when no split tiles either.
+    UnknownShapeError, ParameterError
+        On invalid options.
+
+    Examples
+    --------
+    >>> ts = tile_workspace(np.zeros((7, 6), dtype=bool), overlap=True)
+    >>> len(ts), int(ts.coverage().sum()), ts.complete
+    (12, 48, True)
+    """
+    occ, cell_size = _as_occupancy(workspace)
+    patterns = _check_shapes(shapes)
+    seed, deadline = _check_options(method, shuffle, seed, time_limit)
+    check_weights(weights)
+    overlap = check_bool(overlap, "overlap")
+    try:
+        try:
+            tiles = _tilings(occ, patterns, method, seed, deadline, 1)[0]
+        except _TimeLimit:
+            raise
+        except TilingError as err:
+            if not overlap:
+                raise
+            tiles = _overlapping_tiles(occ, patterns, method, seed, deadline, err)
+    except _TimeLimit as err:
+        raise _retime(method, time_limit) from err
+    return block_locations(occ, tiles, weights=weights, cell_size=cell_size, name=name)
+
+
+def enumerate_tilings(workspace, *, shapes=None, limit: int = 10, method: str = "backtracking",
+                      time_limit: float | None = None, weights=DEFAULT_BLOCK_WEIGHTS) -> list[Tileset]:
+    """Up to ``limit`` distinct tilings of a workspace (distinct as sets of tiles), labelled.
+
+    The backtracker continues its depth-first search after each tiling (so the tilings come in its
+    search order); CP-SAT enumerates solutions on one worker. Both are deterministic. When the time
+    limit runs out after some tilings were found, those are returned.
+
+    Parameters
+    ----------
+    workspace : Workspace or ndarray of bool, shape (H, W)
+        The map.
+    shapes, method, time_limit
+        As in :func:`find_tiles`.
+    limit : int
+        Most tilings to return (at least 1).
+    weights : sequence of 4 float
+        The eq.-2 weights of Algorithm 1.
+
+    Returns
+    -------
+    list of Tileset
+        Between 1 and ``limit`` tilings, each numbered and labelled as by :func:`tile_workspace`.
+
+    Raises
+    ------
+    TilingError
+        If the map has no tiling, or the time limit runs out before the first.
+    UnknownShapeError, ParameterError
+        On invalid options (``limit`` not a positive integer, among others).
+
+    Examples
+    --------
+    >>> len(enumerate_tilings(np.zeros((4, 4), dtype=bool), shapes="O", limit=5))
+    1
+    """
+    occ, cell_size = _as_occupancy(workspace)
+    patterns = _check_shapes(shapes)
+    limit = check_int(limit, "limit", minimum=1)
+    _, deadline = _check_options(method, False, None, time_limit)
+    check_weights(weights)
+    try:
+        found = _tilings(occ, patterns, method, None, deadline, limit)
+    except _TimeLimit as err:
+        raise _retime(method, time_limit) from err
+    return [block_locations(occ, tiles, weights=weights, cell_size=cell_size) for tiles in found]

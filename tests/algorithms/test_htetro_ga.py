@@ -1,0 +1,161 @@
+"""The hTetro-GA: reproducible, optimal on an easy map, trimmed chromosomes, and pymoo's operator contract."""
+
+import numpy as np
+import pytest
+from pymoo.core.population import Population
+from pymoo.optimize import minimize
+
+from htetro_opt.algorithms import ConvergenceRecorder, FrontConvergence, HTetroGA, make_algorithm, trim_reached
+from htetro_opt.errors import ParameterError
+from htetro_opt.model import Pose, Workspace, format_commands, parse_commands
+from htetro_opt.operators import (
+    CommandMutation,
+    CommandRearrangement,
+    CommandRemoval,
+    CommandRepair,
+    as_column,
+    sequences,
+)
+from htetro_opt.problems import CommandPathProblem
+from htetro_opt.solvers.grid_paths import plan_exact
+
+
+def bordered(width=12, height=12):
+    occ = np.zeros((height, width), dtype=bool)
+    occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
+    return occ
+
+
+OPEN = Workspace(bordered())
+START, GOAL = Pose(3, 3, "O", 0), Pose(7, 6, "O", 0)
+
+
+@pytest.fixture(scope="module")
+def problem():
+    return CommandPathProblem(OPEN, START, GOAL, max_length=20)
+
+
+def population_arrays(res):
+    return res.pop.get("F"), [s.tolist() for s in sequences(res.pop.get("X"))]
+
+
+def frozen(**options):
+    """An hTetro-GA whose variation operators are never applied (pymoo ``prob`` 0) although each would
+    change every gene it is applied to (rate 1), and with neither repair nor shortcut."""
+    return HTetroGA(pop_size=10, removal=CommandRemoval(1.0, 1.0, prob=0.0),
+                    rearrangement=CommandRearrangement(1.0, prob=0.0), mutation=CommandMutation(1.0, prob=0.0),
+                    crossover_rate=0.0, repair=False, shortcut=False, **options)
+
+
+def test_htetro_ga_is_reproducible(problem):
+    runs = [minimize(problem, HTetroGA(pop_size=20), ("n_gen", 10), seed=seed) for seed in (4, 4, 5)]
+    (F0, X0), (F1, X1), (F2, X2) = (population_arrays(r) for r in runs)
+    assert np.array_equal(F0, F1) and X0 == X1
+    assert np.array_equal(runs[0].F, runs[1].F)
+    assert not (X0 == X2 and np.array_equal(F0, F2))  # the seed matters
+
+
+def test_htetro_ga_finds_the_exact_optimum_on_an_open_map(problem):
+    exact = plan_exact(OPEN, [START, GOAL])
+    assert exact.reached and exact.time == 7.0
+    best = 1 - exact.time / problem.t_max
+    res = minimize(problem, HTetroGA(pop_size=20), ("n_gen", 40), seed=1)
+    F = res.pop.get("F")
+    reached = F[:, 0] == -1.0
+    assert reached.any()
+    assert -F[reached, 1].min() == pytest.approx(best)  # the fastest goal-reaching member is optimal
+    assert (-F[:, 1][reached] <= best + 1e-12).all()  # and nobody beats the exact planner
+    assert (res.F[:, 0] == -1.0).all()  # the optimum (rank 0) reaches the goal
+
+
+def test_reaching_members_are_trimmed_and_their_fitness_is_current(problem):
+    res = minimize(problem, HTetroGA(pop_size=20), ("n_gen", 8), seed=2)
+    X, F = sequences(res.pop.get("X")), res.pop.get("F")
+    reached, executed = res.pop.get("reached").astype(bool), res.pop.get("executed").astype(int)
+    assert reached.any()
+    again = problem.simulate(X)  # the stored values are those of the chromosomes as they now are
+    assert np.array_equal(again.reached, reached) and np.array_equal(again.executed, executed)
+    assert np.array_equal(problem.evaluate(as_column(X)), F)
+    for x, r, n in zip(X, reached, executed):
+        if r:
+            assert len(x) == n  # no genes after the goal
+
+
+def test_trim_reached_flag():
+    problem = CommandPathProblem(OPEN, START, Pose(4, 3, "O", 0), max_length=20)  # one step away: random walks reach it
+    kept = minimize(problem, HTetroGA(pop_size=20, trim_reached=False), ("n_gen", 1), seed=0)
+    X, reached, executed = sequences(kept.pop.get("X")), kept.pop.get("reached"), kept.pop.get("executed")
+    assert any(r and len(x) > n for x, r, n in zip(X, reached, executed))  # the initial genes run past the goal
+    trimmed = minimize(problem, HTetroGA(pop_size=20), ("n_gen", 1), seed=0)
+    X, reached, executed = sequences(trimmed.pop.get("X")), trimmed.pop.get("reached"), trimmed.pop.get("executed")
+    assert reached.any() and all(len(x) == n for x, r, n in zip(X, reached, executed) if r)
+
+
+def test_trim_reached_function():
+    seqs = [parse_commands("x+,x+,y+,y-"), parse_commands("x+,x+,y+"), parse_commands("y+,y+")]
+    pop = Population.new("X", as_column(seqs))
+    pop.set("reached", np.array([True, False, True]), "executed", np.array([2, 1, 2]))
+    assert trim_reached(pop) is pop
+    assert [format_commands(s) for s in sequences(pop.get("X"))] == [["x+", "x+"], ["x+", "x+", "y+"], ["y+", "y+"]]
+    assert len(trim_reached(Population.empty())) == 0
+
+
+@pytest.mark.parametrize("options", [dict(pop_size=1), dict(pop_size=2.5), dict(pop_size=True),
+                                     dict(crossover_rate=1.5), dict(crossover_rate=-0.1), dict(niche_size=-1),
+                                     dict(repair=1), dict(shortcut="no"), dict(trim_reached=None)])
+def test_htetro_ga_parameters(options):
+    with pytest.raises(ParameterError):
+        HTetroGA(**options)
+
+
+def test_as_published_switches_every_addition_off():
+    ours, paper = HTetroGA(10), make_algorithm("htetro-ga-paper", 10)
+    assert isinstance(ours.repair, CommandRepair) and ours.shortcut and ours.survival.niche_size == 3
+    assert not isinstance(paper.repair, CommandRepair) and not paper.shortcut and paper.survival.niche_size == 0
+
+
+# --- pymoo's operator contract ----------------------------------------------------------------
+def test_operators_run_through_do_so_their_prob_is_honoured(problem):
+    # Applied through ``_do``, removal, rearrangement and mutation at rate 1 would change every
+    # chromosome; through ``do`` with prob 0 they change none, so no generation has anything new.
+    algorithm = frozen()
+    algorithm.setup(problem, termination=("n_gen", 10), seed=0)
+    algorithm.next()  # the initial population
+    assert algorithm._infill() is None
+    # the same operators with pymoo's default prob do produce offspring
+    lively = HTetroGA(pop_size=10, removal=CommandRemoval(1.0, 1.0), rearrangement=CommandRearrangement(1.0),
+                      mutation=CommandMutation(1.0), crossover_rate=0.0, repair=False, shortcut=False)
+    lively.setup(problem, termination=("n_gen", 10), seed=0)
+    lively.next()
+    off = lively._infill()
+    assert off is not None and len(off) > 0
+
+
+def test_a_mutation_applied_to_some_individuals_only(problem):
+    # prob 0.5: about half the non-conservative children are mutated, the others are the parents
+    algorithm = HTetroGA(pop_size=40, removal=CommandRemoval(0.0, 0.0, prob=0.0),
+                         rearrangement=CommandRearrangement(0.0, prob=0.0), mutation=CommandMutation(1.0, prob=0.5),
+                         crossover_rate=0.0, repair=False, shortcut=False)
+    algorithm.setup(problem, termination=("n_gen", 10), seed=3)
+    algorithm.next()
+    parents = {tuple(x.tolist()) for x in sequences(algorithm.pop.get("X"))}
+    off = sequences(algorithm._infill().get("X"))
+    assert all(tuple(x.tolist()) not in parents for x in off)  # offspring are new chromosomes only
+    assert 0.2 * len(parents) < len(off) < 0.8 * len(parents)
+
+
+def test_a_generation_without_offspring_does_not_end_the_run():
+    # Nothing new is ever made: each generation is one without improvement, and the run ends by its
+    # termination (the generation cap, or patience once the goal is reached), not at the first one.
+    far = CommandPathProblem(OPEN, START, Pose(8, 8, "O", 0), max_length=4)  # 10 cells away, 4 genes
+    recorder = ConvergenceRecorder()
+    res = minimize(far, frozen(), FrontConvergence(max_gen=7, patience=3), seed=0, callback=recorder)
+    assert len(recorder.history) == 7 and res.data["converged"] is False
+    assert recorder.reach_generation is None
+
+    near = CommandPathProblem(OPEN, START, Pose(4, 3, "O", 0), max_length=10)  # reached by the initial walks
+    recorder = ConvergenceRecorder()
+    res = minimize(near, frozen(), FrontConvergence(max_gen=50, patience=3), seed=0, callback=recorder)
+    assert recorder.reach_generation == 1
+    assert res.data["converged"] is True
+    assert len(recorder.history) == 4  # generation 1, then 3 without improvement
