@@ -20,10 +20,11 @@ import numpy as np
 
 from htetro_opt import __version__
 from htetro_opt._argparse import Parser, UsageError
+from htetro_opt._console import Console
 from htetro_opt._files import check_output_path, write_text
 from htetro_opt._validation import check_int, check_real, check_seed, check_time_limit
 from htetro_opt.algorithms import GA_ALGORITHMS
-from htetro_opt.errors import HtetroError, ParameterError, PlanningError, ScenarioError
+from htetro_opt.errors import HtetroError, OutputError, ParameterError, PlanningError, ScenarioError
 from htetro_opt.model import Simulator, parse_commands
 from htetro_opt.model.commands import DIAGONAL_COMMANDS, SEED000_COMMANDS
 from htetro_opt.model.robot import STATE_NAMES
@@ -40,7 +41,7 @@ from htetro_opt.scenarios import (
     tileset_path,
 )
 from htetro_opt.solvers.grid_paths import EXACT_METHODS, PLAN_METHODS, plan_path
-from htetro_opt.solvers.sequencing import SEQUENCE_METHODS, sequence_waypoints
+from htetro_opt.solvers.sequencing import SEQUENCE_METHODS, TIME_LIMIT_TEXT, sequence_waypoints
 from htetro_opt.solvers.tiling import TILING_METHODS, tile_workspace
 
 __all__ = ["main", "main_entry", "build_parser"]
@@ -49,18 +50,22 @@ __all__ = ["main", "main_entry", "build_parser"]
 _STUDY_ENVIRONMENTS = ("random", "spiral", "h_shape", "three_slit", "perpendicular_dynamic", "parallel_dynamic")
 
 EXIT_ERROR = 2
-GA_DEFAULTS = {"pop_size": 50, "max_gen": 1000, "patience": 100, "max_length": 100, "seed": 0}
+GA_DEFAULTS = {"pop_size": 50, "max_gen": 1000, "patience": 100, "max_length": None, "seed": 0}
 """Defaults of ``plan``'s GA options (None in the parser, so that one given to an exact method is refused)."""
 TILING_TIME_LIMIT = 60.0  # the backtracker can search long on cluttered maps with few allowed shapes
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = Parser(prog="htetro-opt", description="Path planning for the hTetro reconfigurable robot.")
+    parser = Parser(prog="htetro-opt", description="Path planning for the hTetro reconfigurable robot.",
+                    epilog="The robot model, the scenario and tileset formats and the JSON output are described in "
+                    "docs/model.md and docs/formats.md of the htetro-opt repository. Times are in seconds under the "
+                    "default timing. Long work shows progress on stderr when it is a terminal (--quiet: none).")
     parser.add_argument("--version", action="version", version=f"htetro-opt {__version__}")
     sub = parser.add_subparsers(dest="command", parser_class=Parser, metavar="COMMAND")
 
     p = sub.add_parser("scenarios", help="list the bundled scenarios")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
 
     p = sub.add_parser("plan", help="plan a path through a scenario's roadmap")
     p.add_argument("scenario", help="bundled scenario name or path to a scenario TOML file")
@@ -76,12 +81,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help="GA methods: stop a leg after this many generations without improvement "
                         f"once its goal is reached (default {GA_DEFAULTS['patience']})")
     p.add_argument("--max-length", type=int,
-                   help=f"GA methods: l_p,max, the initial chromosome length (default {GA_DEFAULTS['max_length']})")
+                   help="GA methods: l_p,max, the initial chromosome length (default, per leg: the larger of 100 "
+                        "and twice the grid distance from the leg's start to its goal)")
     p.add_argument("--seed", type=int,
                    help=f"GA methods: random seed, the same seed giving the same plan (default {GA_DEFAULTS['seed']})")
     p.add_argument("--diagonals", action="store_true", help="dijkstra, astar: allow diagonal translations")
     p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
     p.add_argument("--plot", metavar="FILE", help="save a plot of the map and the path (format from the extension)")
 
     p = sub.add_parser(
@@ -93,9 +100,11 @@ def build_parser() -> argparse.ArgumentParser:
         "first invalid one.",
     )
     p.add_argument("scenario", help="bundled scenario name or path to a scenario TOML file")
-    p.add_argument("--commands", required=True, help='comma- or space-separated tokens, e.g. "x+,x+,sI"')
+    p.add_argument("--commands", required=True,
+                   help='comma- or space-separated tokens, e.g. "x+,x+,sI"; @FILE reads them from a file, - from stdin')
     p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
     p.add_argument("--plot", metavar="FILE", help="save a plot of the map and the executed path")
 
     p = sub.add_parser(
@@ -117,6 +126,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"give up after this many seconds (default {TILING_TIME_LIMIT:g})")
     p.add_argument("--out", metavar="FILE", help="write the labelled tileset to FILE")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
     p.add_argument("--plot", metavar="FILE", help="save a plot of the tileset (format from the extension)")
 
     p = sub.add_parser(
@@ -137,10 +147,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="eq. 2's weights α,β,λ,γ of blocks a,b,c,d (default 0.25 each)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0; deterministic methods ignore it)")
     p.add_argument("--time-limit", type=float,
-                   help="time budget in seconds (exact: 60 by default; ortools: 1 s up to 20 waypoints, "
-                        "rising to 30 s at 40 and beyond; ga, local, greedy: none)")
+                   help=f"time budget in seconds; by default, sized to the instance: {TIME_LIMIT_TEXT}")
     p.add_argument("--shapes", help="when TILESET is a scenario: allowed morphologies for the tiling")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
     p.add_argument("--plot", metavar="FILE", help="save a plot of the tileset and the order (format from the extension)")
     p = sub.add_parser(
         "study",
@@ -160,14 +170,48 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--method", choices=GA_ALGORITHMS, default="htetro-ga", help="the GA (default htetro-ga)")
     q.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
     q.add_argument("--out", metavar="DIR", help="write DIR/table4.csv and DIR/table4.md")
-    q.add_argument("--progress", action="store_true", help="report each finished trial on stderr")
     q.add_argument("--json", action="store_true", help="print one JSON object (the records) instead of the table")
+    q.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
     q = studies.add_parser("seed003", help="Le et al. 2018, Tables 1–5: tiling and waypoint sequencing")
     q.add_argument("--seeds", type=int, default=5, help="seeds of the stochastic methods (default 5)")
     q.add_argument("--time-limit", type=float, help="cap in seconds for each method that takes one")
     q.add_argument("--out", metavar="DIR", help="write DIR/seed003.md and DIR/seed003.csv")
     q.add_argument("--json", action="store_true", help="print one JSON object (the records) instead of the report")
+    q.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
     return parser
+
+
+class _LateOutputError(Exception):
+    """An output file failed after the work was done: the command's result is still printed."""
+
+    def __init__(self, out: dict, error: HtetroError) -> None:
+        super().__init__(str(error))
+        self.out, self.error = out, error
+
+
+def _late(out: dict, write) -> None:
+    """Run one output write; if it fails, carry the finished result along with the error."""
+    try:
+        write()
+    except OutputError as err:
+        raise _LateOutputError(out, err) from err
+
+
+def _stderr_is_terminal() -> bool:
+    return sys.stderr.isatty()
+
+
+def _console(args) -> Console:
+    """Progress bars on stderr: on a terminal, unless ``--quiet``."""
+    return Console(enabled=not getattr(args, "quiet", False) and _stderr_is_terminal())
+
+
+def _save_plot(console: Console, figure_of, path: str) -> None:
+    """Draw (``figure_of()``) and save a plot, showing progress: long paths take a while."""
+    from htetro_opt.viz import save_figure
+
+    with console.step(f"plotting {path}"):
+        save_figure(figure_of(), path)
 
 
 def _grid_scenario(name: str) -> Scenario:
@@ -210,7 +254,7 @@ def _cmd_scenarios(args) -> dict:
     for name in list_tilesets():
         ts = load_tileset(tileset_path(name))
         tilesets.append({"name": name, "size": [ts.width, ts.height], "tiles": len(ts),
-                         "source": "seed 003 (Le et al., Electronics 2018), the paper's labelled tileset"})
+                         "source": "Le et al., Electronics 2018: the paper's labelled tileset"})
     if not args.json:
         width = max((len(r["name"]) for r in rows + tilesets), default=4)
         for r in rows:
@@ -241,7 +285,7 @@ def _cmd_plan(args) -> dict:
         options = dict(pop_size=check_int(args.pop_size, "--pop-size", minimum=2),
                        max_gen=check_int(args.max_gen, "--max-gen", minimum=1),
                        patience=check_int(args.patience, "--patience", minimum=1),
-                       max_length=check_int(args.max_length, "--max-length", minimum=1),
+                       max_length=check_int(args.max_length, "--max-length", minimum=1, allow_none=True),
                        seed=check_seed(args.seed, "--seed"))
     else:
         if given:
@@ -249,7 +293,11 @@ def _cmd_plan(args) -> dict:
             raise ParameterError(f"{flags} applies to the GA methods only, not to --method {args.method} "
                                  "(an exact method has no population, generations or randomness)")
         options = dict(diagonals=args.diagonals)
-    plan = plan_path(scenario.workspace, scenario.roadmap, method=args.method, clearance=clearance, **options)
+    console = _console(args)
+    with console.step(f"planning ({args.method})", options.get("max_gen"), "generations") as progress:
+        if genetic:
+            options["progress"] = progress
+        plan = plan_path(scenario.workspace, scenario.roadmap, method=args.method, clearance=clearance, **options)
     out = {
         "scenario": scenario.name,
         "method": plan.method,
@@ -262,21 +310,25 @@ def _cmd_plan(args) -> dict:
     if genetic:
         out.update(_ga_fields(plan, args))
     if args.plot:
-        from htetro_opt.viz import plot_ga_plan, plot_path, save_figure
+        from htetro_opt.viz import plot_ga_plan, plot_path
 
         method = f"{args.method} (n_pop {args.pop_size}, seed {args.seed})" if genetic else args.method
         status = "reached" if plan.reached else f"goal NOT reached (leg {plan.failed_leg + 1} {'not solved' if genetic else 'has no path'})"
-        title = f"{scenario.name}: {method}, time {plan.time:g}, {len(plan.tokens)} commands, {status}"
+        title = f"{scenario.name}: {method}, time {plan.time:g} s, {len(plan.tokens)} commands, {status}"
         if genetic:
-            figure = plot_ga_plan(scenario.workspace, plan, roadmap=scenario.roadmap, hidden=scenario.hidden, title=title)
+            def figure():
+                return plot_ga_plan(scenario.workspace, plan, roadmap=scenario.roadmap, hidden=scenario.hidden,
+                                    title=title)
         else:
-            figure = plot_path(scenario.workspace, plan.poses, roadmap=scenario.roadmap, hidden=scenario.hidden, title=title)
-        save_figure(figure, args.plot)
+            def figure():
+                return plot_path(scenario.workspace, plan.poses, roadmap=scenario.roadmap, hidden=scenario.hidden,
+                                 title=title)
+        _late(out, lambda: _save_plot(console, figure, args.plot))
     if not args.json:
         legs = len(scenario.roadmap) - 1
         failure = "was not solved" if genetic else "has no path"
         status = "reached" if plan.reached else f"NOT reached: leg {plan.failed_leg + 1} of {legs} {failure}"
-        print(f"{scenario.name}: {status} ({plan.method}, {plan.runtime_s:.3f} s); time {plan.time:g}, "
+        print(f"{scenario.name}: {status} ({plan.method}, {plan.runtime_s:.3f} s); time {plan.time:g} s, "
               f"{len(plan.tokens)} commands")
         if genetic:
             fitness = ", ".join(f"{k} {v:.3f}" for k, v in out["fitness"].items())
@@ -320,11 +372,12 @@ def _ga_fields(plan, args) -> dict:
 def _cmd_simulate(args) -> dict:
     scenario = _grid_scenario(args.scenario)
     clearance = _check_clearance(args.clearance)
-    _outputs(args)
+    _outputs(args, ("plot", "plot"))
     if scenario.start is None:
         raise PlanningError(f"scenario {scenario.name!r} has no start configuration to simulate from")
-    sequence = parse_commands(args.commands)
-    used = sorted(set(SEED000_COMMANDS) | set(DIAGONAL_COMMANDS) | {t for t in args.commands.replace(",", " ").split()})
+    text = _commands_text(args.commands)
+    sequence = parse_commands(text)
+    used = sorted(set(SEED000_COMMANDS) | set(DIAGONAL_COMMANDS) | {t for t in text.replace(",", " ").split()})
     world = scenario.true_workspace()
     sim = Simulator(world, commands=used, clearance=clearance)
     result = sim.run([sequence], scenario.start, roadmap=scenario.roadmap[1:])
@@ -339,17 +392,17 @@ def _cmd_simulate(args) -> dict:
         "time": float(result.time[0]),
     }
     if args.plot:
-        from htetro_opt.viz import plot_path, save_figure
+        from htetro_opt.viz import plot_path
 
         state = "valid" if out["valid"] else f"invalid at command index {first_invalid} (0-based)"
         title = f"{scenario.name}: {out['executed']} of {len(sequence)} commands executed ({state})"
-        save_figure(plot_path(world, result.poses(0), roadmap=scenario.roadmap,
-                              hidden=scenario.hidden, title=title), args.plot)
+        _late(out, lambda: _save_plot(_console(args), lambda: plot_path(
+            world, result.poses(0), roadmap=scenario.roadmap, hidden=scenario.hidden, title=title), args.plot))
     if not args.json:
         f = out["final"]
         print(f"{'valid' if out['valid'] else f'INVALID at command index {first_invalid} (0-based)'}; "
               f"executed {out['executed']} of {len(sequence)}; reached: {out['reached']}; "
-              f"final ({f['x']}, {f['y']}) {f['shape']} heading {f['heading']}; time {out['time']:g}")
+              f"final ({f['x']}, {f['y']}) {f['shape']} heading {f['heading']}; time {out['time']:g} s")
     return out
 
 
@@ -367,22 +420,25 @@ def _cmd_tile(args) -> dict:
     seed = check_seed(0 if args.seed is None else args.seed, "--seed")
     _outputs(args, ("out", "tileset"), ("plot", "plot"))
     shapes = list(args.shapes) if args.shapes else None
+    console = _console(args)
     began = time.perf_counter()
-    tileset = _tileset_of_scenario(args.scenario, shapes=shapes, method=args.method, shuffle=args.shuffle,
-                                   seed=seed, time_limit=time_limit, overlap=args.overlap)
+    with console.step(f"tiling ({args.method})"):
+        tileset = _tileset_of_scenario(args.scenario, shapes=shapes, method=args.method, shuffle=args.shuffle,
+                                       seed=seed, time_limit=time_limit, overlap=args.overlap)
     runtime = time.perf_counter() - began
     counts = {shape: tileset.shapes.count(shape) for shape in sorted(set(tileset.shapes))}
     out = {"scenario": tileset.name, "method": args.method, "tiles": len(tileset), "shapes": counts,
            "overlapping": tileset.overlapping, "runtime_s": round(runtime, 6), "out": args.out}
     if args.plot:  # before the tileset file: a failed plot leaves no tileset written either
-        from htetro_opt.viz import plot_tileset, save_figure
+        from htetro_opt.viz import plot_tileset
 
-        save_figure(plot_tileset(tileset, title=f"{tileset.name}: {len(tileset)} tiles ({args.method})"), args.plot)
+        title = f"{tileset.name}: {len(tileset)} tiles ({args.method})"
+        _late(out, lambda: _save_plot(console, lambda: plot_tileset(tileset, title=title), args.plot))
     if args.out:
         try:
-            save_tileset(tileset, args.out)
-        except HtetroError:
-            if args.plot:
+            _late(out, lambda: save_tileset(tileset, args.out))
+        except _LateOutputError:
+            if args.plot:  # a failed command leaves no output behind
                 os.unlink(args.plot)
             raise
     if args.json:
@@ -394,6 +450,35 @@ def _cmd_tile(args) -> dict:
     else:
         print(format_tileset(tileset))
     return out
+
+
+def _weights(text: str) -> np.ndarray:
+    """``--weights a,b,c,d`` as eq. 2's weights, each error naming the option."""
+    parts = [v.strip() for v in text.split(",")]
+    try:
+        values = [float(v) for v in parts]
+    except ValueError:
+        raise ParameterError(f"--weights must be four comma-separated numbers a,b,c,d, got {text!r}") from None
+    if len(values) != 4:
+        raise ParameterError(f"--weights must be four comma-separated numbers a,b,c,d, got {len(values)}: {text!r}")
+    if not all(0 <= v <= 1e6 for v in values) or sum(values) <= 0:  # huge weights overflow the costs
+        raise ParameterError(f"--weights must be numbers in [0, 1e6] with a positive sum, got {text!r}")
+    return check_weights(values)
+
+
+def _commands_text(argument: str) -> str:
+    """``--commands``: the tokens themselves, ``@FILE`` for a file of them, or ``-`` for stdin
+    (a long sequence does not fit on a command line)."""
+    if argument == "-":
+        return sys.stdin.read()
+    if argument.startswith("@"):
+        path = Path(argument[1:])
+        try:
+            return path.read_text(encoding="utf-8-sig")
+        except (OSError, UnicodeDecodeError) as err:
+            raise ParameterError(f"--commands {argument}: cannot read {str(path)!r}: "
+                                 f"{getattr(err, 'strerror', None) or err}") from err
+    return argument
 
 
 def _is_scenario(name: str) -> bool:
@@ -408,10 +493,7 @@ def _cmd_sequence(args) -> dict:
     time_limit = check_time_limit(args.time_limit, "--time-limit")
     seed = check_seed(args.seed, "--seed")
     _outputs(args, ("plot", "plot"))
-    try:
-        weights = check_weights([float(v) for v in args.weights.split(",")])
-    except ValueError as err:
-        raise ParameterError(f"--weights must be four comma-separated numbers a,b,c,d, got {args.weights!r}") from err
+    weights = _weights(args.weights)
     if args.start == "free":
         start = None
     else:
@@ -419,24 +501,30 @@ def _cmd_sequence(args) -> dict:
             start = int(args.start)
         except ValueError as err:
             raise ParameterError(f"--start must be a tile label or 'free', got {args.start!r}") from err
+    console = _console(args)
     if _is_scenario(args.tileset):
         scenario_path(args.tileset)  # a clear error for a missing file
-        tileset = _tileset_of_scenario(args.tileset, shapes=list(args.shapes) if args.shapes else None)
+        with console.step("tiling (backtracking)"):
+            tileset = _tileset_of_scenario(args.tileset, shapes=list(args.shapes) if args.shapes else None)
+        name = tileset.name
     else:
         if args.shapes:
             raise ParameterError("--shapes applies only when TILESET is a scenario to tile")
         tileset = load_tileset(tileset_path(args.tileset))
+        name = Path(args.tileset).stem  # the name the user gave, never an install path
     instance = SequencingInstance.from_tileset(tileset, start=start, weights=weights)
-    result = sequence_waypoints(instance, method=args.method, seed=seed, time_limit=time_limit)
-    out = {"tileset": tileset.name, "waypoints": instance.n, "start": args.start, "weights": weights.tolist(),
+    with console.step(f"sequencing {instance.n} waypoints ({args.method})") as progress:
+        result = sequence_waypoints(instance, method=args.method, seed=seed, time_limit=time_limit, progress=progress)
+    out = {"tileset": name, "waypoints": instance.n, "start": args.start, "weights": weights.tolist(),
            **result.as_dict()}
     if args.plot:
-        from htetro_opt.viz import plot_tileset, save_figure
+        from htetro_opt.viz import plot_tileset
 
-        title = f"{tileset.name}: {result.method}, cost {result.cost:.3f}"
-        save_figure(plot_tileset(tileset, order=result.tiles, title=title), args.plot)
+        title = f"{name}: {result.method}, cost {result.cost:.3f} cells"
+        _late(out, lambda: _save_plot(console, lambda: plot_tileset(tileset, order=result.tiles, title=title),
+                                      args.plot))
     if not args.json:
-        print(f"{tileset.name}: {instance.n} waypoints, {result.method}, cost {result.cost:.4f} "
+        print(f"{name}: {instance.n} waypoints, {result.method}, cost {result.cost:.4f} "
               f"in {result.runtime_s:.3f} s")
         print(" ".join(str(t) for t in result.tiles))
     return out
@@ -479,33 +567,40 @@ def _cmd_study(args) -> dict:
                        method=args.method, jobs=check_int(args.jobs, "--jobs", minimum=1))
         pop_sizes = [check_int(n, "--pop-sizes", minimum=2) for n in _int_list(args.pop_sizes, "--pop-sizes")]
 
-        def report(done: int, total: int, record: dict) -> None:
-            print(f"[{done}/{total}] {record['environment']} n_pop={record['pop_size']} seed={record['seed']}: "
-                  f"{'reached' if record['reached'] else 'not reached'} in "
-                  f"{record['terminate_generation']} generations, {record['terminate_time_s']:.1f} s",
-                  file=sys.stderr, flush=True)
+        console = _console(args)
+        with console.step("table4 trials", 1) as progress:
+            def report(done: int, total: int, record: dict) -> None:
+                progress(done, total, f"last: {record['environment']} n_pop={record['pop_size']} "
+                                      f"seed={record['seed']} {'reached' if record['reached'] else 'not reached'}")
 
-        records = table4.run_study(envs, pop_sizes, range(args.seeds), progress=report if args.progress else None,
-                                   **options)
+            records = table4.run_study(envs, pop_sizes, range(args.seeds), progress=report, **options)
         text = table4.markdown_table(table4.summarise(records))
-        if out is not None:
-            out.mkdir(parents=True, exist_ok=True)
-            table4.write_csv(records, out / "table4.csv")
-            write_text(out / "table4.md", text, what="study table")
+        files = {"table4.csv": lambda path: table4.write_csv(records, path),
+                 "table4.md": lambda path: write_text(path, text, what="study table")}
     else:
         from htetro_opt.studies import seed003
 
         time_limit = check_time_limit(args.time_limit, "--time-limit")
-        records = seed003.run_study(seeds=range(args.seeds), time_limit=time_limit,
-                                    progress=lambda message: print(message, file=sys.stderr, flush=True))
+        with _console(args).step("seed003 study") as progress:
+            records = seed003.run_study(seeds=range(args.seeds), time_limit=time_limit,
+                                        progress=lambda message: progress(0, None, message))
         text = seed003.markdown_report(records) + "\n"
-        if out is not None:
-            out.mkdir(parents=True, exist_ok=True)
-            seed003.write_csv(records, out / "seed003.csv")
-            write_text(out / "seed003.md", text, what="study report")
+        files = {"seed003.csv": lambda path: seed003.write_csv(records, path),
+                 "seed003.md": lambda path: write_text(path, text, what="study report")}
+    result = {"study": args.study, "records": records, "out": None if out is None else str(out)}
+    if out is not None:
+        def write_all() -> None:
+            try:
+                out.mkdir(parents=True, exist_ok=True)
+            except OSError as err:
+                raise OutputError(f"cannot create the study folder {str(out)!r}: {err.strerror or err}") from err
+            for file_name, write in files.items():
+                write(out / file_name)
+
+        _late(result, write_all)
     if not args.json:
         print(text, end="")
-    return {"study": args.study, "records": records, "out": None if out is None else str(out)}
+    return result
 
 
 _COMMANDS = {"scenarios": _cmd_scenarios, "plan": _cmd_plan, "simulate": _cmd_simulate,
@@ -531,6 +626,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         out = _COMMANDS[args.command](args)
     except (UsageError, HtetroError) as err:
         print("error: " + " ".join(str(err).split()), file=sys.stderr)
+        return EXIT_ERROR
+    except _LateOutputError as late:  # the work is done: its result is not thrown away with the file
+        if getattr(args, "json", False):
+            print(json.dumps(late.out))
+        print("error: " + " ".join(str(late.error).split()), file=sys.stderr)
         return EXIT_ERROR
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)

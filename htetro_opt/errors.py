@@ -57,7 +57,7 @@ class PlanningError(HtetroError, RuntimeError):
 
 
 class TilesetFormatError(MapFormatError):
-    """A labelled tileset (seed 003) is malformed: an unknown token, a tile without one of its blocks a–d."""
+    """A labelled tileset (Le et al. 2018) is malformed: an unknown token, a tile without one of its blocks a–d."""
 
 
 class TilingError(PlanningError):

@@ -731,3 +731,108 @@ def test_a_signal_ends_a_long_run_quietly_within_a_second(signame, code, word, t
     assert err.strip() == word and "Traceback" not in err
     assert took < 1.5
     assert list(tmp_path.iterdir()) == []  # no plot, no temporary file
+
+
+# --------------------------------------------------------------------------------------------------
+# Progress on stderr, late writes, inputs from files
+
+
+def test_progress_is_shown_on_a_terminal_and_not_with_quiet(capsys, monkeypatch, near):
+    import htetro_opt.cli as cli
+
+    monkeypatch.setattr(cli, "_stderr_is_terminal", lambda: True)
+    argv = ["plan", near, "--method", "htetro-ga", "--pop-size", "8", "--max-gen", "30", "--patience", "5",
+            "--max-length", "20", "--json"]
+    code, out, err = run(capsys, argv)
+    assert code == 0 and json.loads(out)["method"] == "htetro-ga"  # stdout stays one JSON object
+    assert "planning (htetro-ga)" in err and "/30 generations" in err and "best f_t" in err
+    code, out, err = run(capsys, [*argv, "--quiet"])
+    assert code == 0 and err == ""
+
+
+def test_no_progress_when_stderr_is_not_a_terminal(capsys, near):
+    code, out, err = run(capsys, ["sequence", "paper_6x6_fig13a", "--method", "greedy", "--json"])
+    assert code == 0 and err == ""
+
+
+def test_sequence_progress_reports_the_methods_own_counts(capsys, monkeypatch):
+    import htetro_opt.cli as cli
+
+    monkeypatch.setattr(cli, "_stderr_is_terminal", lambda: True)
+    code, out, err = run(capsys, ["sequence", "paper_11x11_fig13d", "--method", "greedy", "--json"])
+    assert code == 0
+    assert "sequencing 28 waypoints (greedy)" in err and "10000/10000" in err and "best cost" in err
+
+
+def test_a_plot_that_fails_after_the_work_still_prints_the_result(capsys, monkeypatch, near, tmp_path):
+    import htetro_opt.viz as viz
+    from htetro_opt.errors import OutputError
+
+    def disk_full(figure, path, **kwargs):
+        raise OutputError(f"cannot write plot {str(path)!r}: No space left on device")
+
+    monkeypatch.setattr(viz, "save_figure", disk_full)
+    code, out, err = run(capsys, ["plan", near, "--json", "--plot", str(tmp_path / "p.png")])
+    assert code == 2
+    assert json.loads(out)["reached"] is True  # the finished plan is not thrown away
+    assert err.startswith("error: cannot write plot") and len(err.splitlines()) == 1
+
+
+def test_a_tileset_that_fails_after_the_plot_leaves_neither(capsys, monkeypatch, tmp_path):
+    import htetro_opt.cli as cli
+    from htetro_opt.errors import OutputError
+
+    def disk_full(tileset, path):
+        raise OutputError("cannot write tileset: No space left on device")
+
+    monkeypatch.setattr(cli, "save_tileset", disk_full)
+    code, out, err = run(capsys, ["tile", "tiling_6x6", "--out", str(tmp_path / "t.txt"),
+                                  "--plot", str(tmp_path / "t.png"), "--json"])
+    assert code == 2 and err.startswith("error: cannot write tileset")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("weights,words", [
+    ("0,0,0,0", ["--weights", "positive sum"]),
+    ("-1,1,1,1", ["--weights", "-1,1,1,1"]),
+    ("1e308,1,1,1", ["--weights", "1e6"]),
+    ("1,1,1", ["--weights", "four"]),
+    ("a,b,c,d", ["--weights", "four"]),
+])
+def test_weights_errors_say_what_is_wrong(capsys, weights, words):
+    code, out, err = run(capsys, ["sequence", "paper_6x6_fig13a", "--weights", weights])
+    assert_one_error_line(code, out, err, *words)
+    assert "Warning" not in err
+
+
+def test_commands_from_a_file_and_from_stdin(capsys, monkeypatch, near, tmp_path):
+    import io
+
+    long = tmp_path / "long.txt"
+    long.write_text("x+ x+\ny+, x+\n")
+    from_file = run_json(capsys, ["simulate", near, "--commands", f"@{long}", "--json"])
+    monkeypatch.setattr(sys, "stdin", io.StringIO("x+ x+ y+ x+"))
+    from_stdin = run_json(capsys, ["simulate", near, "--commands", "-", "--json"])
+    inline = run_json(capsys, ["simulate", near, "--commands", "x+,x+,y+,x+", "--json"])
+    assert from_file == from_stdin == inline and inline["executed"] == 4
+    assert_one_error_line(*run(capsys, ["simulate", near, "--commands", f"@{tmp_path / 'none.txt'}"]),
+                          "--commands", "none.txt")
+
+
+def test_sequence_help_shows_the_default_budgets(capsys):
+    assert main(["sequence", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "10 s + 1 s per 50 waypoints, at most 60 s" in text and "exact: 60 s" in text
+
+
+def test_bundled_tileset_is_named_not_located(capsys):
+    out = run_json(capsys, ["sequence", "paper_6x6_fig13a", "--json"])
+    assert out["tileset"] == "paper_6x6_fig13a"
+
+
+def test_help_points_to_the_model_and_format_reference(capsys):
+    assert main(["--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "docs/model.md" in text and "docs/formats.md" in text
+    root = Path(__file__).resolve().parents[1]
+    assert (root / "docs" / "model.md").is_file() and (root / "docs" / "formats.md").is_file()

@@ -39,9 +39,25 @@ def test_the_python_examples_run(tmp_path, monkeypatch, capsys):
     assert "dijkstra True" in printed and "htetro-ga True" in printed  # both plans reached the goal
 
 
-def _subcommands():
-    sub = next(a for a in build_parser()._actions if a.__class__.__name__ == "_SubParsersAction")
+def _subparsers(parser):
+    sub = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
     return sub.choices
+
+
+def _subcommands():
+    """Command name ("plan", "study table4", …) → its parser."""
+    commands = {}
+    for name, parser in _subparsers(build_parser()).items():
+        if name == "study":
+            commands.update({f"study {study}": p for study, p in _subparsers(parser).items()})
+        else:
+            commands[name] = parser
+    return commands
+
+
+def _command_of(entry: str) -> str:
+    words = entry.split()
+    return " ".join(words[1:3]) if words[1] == "study" else words[1]
 
 
 def _synopsis():
@@ -59,7 +75,7 @@ def _synopsis():
 
 @pytest.mark.parametrize("entry", _synopsis())
 def test_the_synopsis_names_real_options_and_methods(entry):
-    command = entry.split()[1]
+    command = _command_of(entry)
     parser = _subcommands()[command]
     options = {s: a for a in parser._actions for s in a.option_strings}
     for flag in re.findall(r"(--[a-z-]+)", entry):
@@ -73,7 +89,7 @@ def test_every_method_is_in_the_synopsis():
     listed = set()
     for entry in _synopsis():
         for names in re.findall(r"--method ([a-z0-9|-]+)", entry):
-            listed |= {(entry.split()[1], name) for name in names.split("|")}
+            listed |= {(_command_of(entry), name) for name in names.split("|")}
     for command, parser in _subcommands().items():
         for action in parser._actions:
             if "--method" in action.option_strings:

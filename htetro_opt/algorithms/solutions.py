@@ -75,18 +75,32 @@ def select_solutions(F: np.ndarray) -> dict[str, int]:
 
 class ConvergenceRecorder(Callback):
     """Records, per generation, whether the goal has been reached and the multi-objective solution's
-    fitnesses. Works under any pymoo algorithm."""
+    fitnesses. Works under any pymoo algorithm.
 
-    def __init__(self, began: float | None = None) -> None:
+    Parameters
+    ----------
+    began : float, optional
+        ``time.perf_counter()`` at the start of the run (default: now).
+    on_generation : callable, optional
+        Called after each generation as ``on_generation(generation, best_f_t, reached)``: the best
+        f_t among goal-reaching individuals (None while none reaches).
+    """
+
+    def __init__(self, began: float | None = None, on_generation=None) -> None:
         super().__init__()
         self.began = _time.perf_counter() if began is None else began
+        self.on_generation = on_generation
         self.reach_generation: int | None = None
         self.reach_time_s: float | None = None
         self.history: list[np.ndarray] = []
 
     def notify(self, algorithm) -> None:
         F = algorithm.pop.get("F")
-        if self.reach_generation is None and (F[:, 0] == -1.0).any():
+        reached = F[:, 0] == -1.0
+        if self.reach_generation is None and reached.any():
             self.reach_generation = int(algorithm.n_gen)
             self.reach_time_s = _time.perf_counter() - self.began
         self.history.append(-F[select_solutions(F)["multi_objective"]])
+        if self.on_generation is not None:
+            best_f_t = float(-F[reached, 1].min()) if reached.any() else None
+            self.on_generation(int(algorithm.n_gen), best_f_t, bool(reached.any()))

@@ -3,7 +3,7 @@
 Command ids are positions in :data:`COMMANDS`; every table of the model is indexed by them. Tokens
 (``x+``, ``r-``, ``sO``, ``3l`` …) are what files, the CLI and JSON use.
 
-Seed 004's single-block commands follow its Table 1: ``l`` turns a block counter-clockwise (+90°),
+Cheng et al. 2019's single-block commands follow its Table 1: ``l`` turns a block counter-clockwise (+90°),
 ``r`` clockwise; ``1l/1r`` move B1 about H1, ``3l/3r`` move B3 with B4 about H2, ``4l/4r`` move B4
 about H3, ``2l/2r`` turn the whole robot about B2 (the same motion as ``r+``/``r-``). Two ``3r`` take
 the I-shape to the O-shape, as the paper states.
@@ -12,13 +12,15 @@ the I-shape to the O-shape, as the paper states.
 from __future__ import annotations
 
 import math
+import numbers
 import re
+import reprlib
 from dataclasses import dataclass, fields
-from typing import Iterable
+from collections.abc import Iterable
 
 import numpy as np
 
-from htetro_opt._validation import check_real
+from htetro_opt._validation import check_bool, check_real
 from htetro_opt.errors import ParameterError, UnknownCommandError
 from htetro_opt.model.robot import SHAPES
 
@@ -96,11 +98,11 @@ _TOKEN_INDEX = {token: i for i, token in enumerate(TOKENS)}
 SEED000_COMMANDS: tuple[str, ...] = ("x+", "x-", "y+", "y-", "r+", "r-") + tuple("s" + s for s in SHAPES)
 """Cheng et al. 2020's command set: the four translations, two rotations and seven shapeshifts."""
 DIAGONAL_COMMANDS: tuple[str, ...] = ("x+y+", "x+y-", "x-y+", "x-y-")
-"""Seed 001's four diagonal translations."""
+"""Do et al. 2021's four diagonal translations."""
 SEED004_COMMANDS: tuple[str, ...] = (
     "stop", "y+", "y-", "x-", "x+", "1l", "1r", "2l", "2r", "3l", "3r", "4l", "4r",
 )
-"""Seed 004's 13 commands (stop, F, B, L, R and the eight block rotations), in its Table 1 order."""
+"""Cheng et al. 2019's 13 commands (stop, F, B, L, R and the eight block rotations), in its Table 1 order."""
 
 
 @dataclass(frozen=True)
@@ -165,30 +167,66 @@ def parse_commands(commands: str | Iterable[str]) -> np.ndarray:
     ------
     UnknownCommandError
         Naming the first unknown token and its position (1-based).
+    ParameterError
+        If ``commands`` is neither a string nor a sequence.
 
     Examples
     --------
     >>> parse_commands("x+,y+ r-").tolist()
     [0, 2, 9]
     """
-    tokens = [t for t in re.split(r"[,\s]+", commands) if t] if isinstance(commands, str) else list(commands)
+    if isinstance(commands, str):
+        tokens = [t for t in re.split(r"[,\s]+", commands) if t]
+    else:
+        tokens = _token_list(commands, "commands")
     ids = np.empty(len(tokens), dtype=np.int64)
     for position, token in enumerate(tokens, start=1):
-        if token not in _TOKEN_INDEX:
+        index = _TOKEN_INDEX.get(token) if isinstance(token, str) else None
+        if index is None:
             raise UnknownCommandError(
-                f"unknown command {token!r} at position {position}: expected one of {' '.join(TOKENS)}"
+                f"unknown command {reprlib.repr(token)} at position {position}: expected one of {' '.join(TOKENS)}"
             )
-        ids[position - 1] = _TOKEN_INDEX[token]
+        ids[position - 1] = index
     return ids
 
 
+def _token_list(tokens, name: str) -> list:
+    """A sequence of command tokens as a list (its items checked by the caller)."""
+    if isinstance(tokens, bytes) or not isinstance(tokens, Iterable):
+        raise ParameterError(f"{name} must be a string of command tokens or a sequence of them, "
+                             f"got {type(tokens).__name__} {reprlib.repr(tokens)}")
+    return list(tokens)
+
+
 def format_commands(ids: Iterable[int]) -> list[str]:
-    """Tokens of a sequence of command ids."""
-    return [TOKENS[int(i)] for i in ids]
+    """Tokens of a sequence of command ids.
+
+    Raises
+    ------
+    UnknownCommandError
+        Naming the first item that is not a command id.
+    ParameterError
+        If ``ids`` is not a sequence.
+
+    Examples
+    --------
+    >>> format_commands([0, 2, 9])
+    ['x+', 'y+', 'r-']
+    """
+    if isinstance(ids, (str, bytes)) or not isinstance(ids, Iterable):
+        raise ParameterError(f"ids must be a sequence of command ids, got {type(ids).__name__} {reprlib.repr(ids)}")
+    tokens = []
+    for position, i in enumerate(np.asarray(ids).reshape(-1).tolist() if isinstance(ids, np.ndarray) else ids, start=1):
+        if isinstance(i, bool) or not isinstance(i, numbers.Integral) or not 0 <= i < N_COMMANDS:
+            raise UnknownCommandError(f"command id {i!r} at position {position} is not a command "
+                                      f"(ids are 0…{N_COMMANDS - 1})")
+        tokens.append(TOKENS[int(i)])
+    return tokens
 
 
 def command_set(*, diagonals: bool = False, seed004: bool = False, tokens: Iterable[str] | None = None) -> tuple[int, ...]:
-    """Ids of a command set: Cheng et al. 2020's by default, plus diagonals, or seed 004's, or given tokens.
+    """Ids of a command set: Cheng et al. 2020's by default, plus diagonals, or Cheng et al. 2019's
+    (``seed004``), or given tokens (a sequence, or a string as :func:`parse_commands` reads it).
 
     Repeated tokens count once.
 
@@ -197,15 +235,16 @@ def command_set(*, diagonals: bool = False, seed004: bool = False, tokens: Itera
     UnknownCommandError
         If a token is not in the vocabulary.
     ParameterError
-        If the set is empty.
+        If the set is empty, ``tokens`` is not a string or sequence, or a flag is not True or False.
 
     Examples
     --------
     >>> len(command_set()), len(command_set(diagonals=True)), len(command_set(seed004=True))
     (13, 17, 13)
     """
+    diagonals, seed004 = check_bool(diagonals, "diagonals"), check_bool(seed004, "seed004")
     if tokens is not None:
-        chosen = [t for t in tokens]
+        chosen = tokens if isinstance(tokens, str) else _token_list(tokens, "tokens")
     elif seed004:
         chosen = list(SEED004_COMMANDS) + (list(DIAGONAL_COMMANDS) if diagonals else [])
     else:

@@ -35,6 +35,7 @@ dynamics; they are a reference to compare with, not something this model reprodu
 from __future__ import annotations
 
 import math
+import reprlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -272,7 +273,9 @@ def simulate_coverage(waypoints, order, *, pixels_per_cell: int = 10, speed: flo
         raise ParameterError(f"waypoints must be a tileset, an instance or an (n, 4, 2) array, got {waypoints!r}") from err
     if blocks.ndim != 3 or blocks.shape[1:] != (4, 2) or not np.issubdtype(blocks.dtype, np.integer) \
             or (blocks.size and blocks.min() < 0):
-        raise ParameterError(f"waypoints must hold (n, 4, 2) non-negative integer block cells, got shape {blocks.shape}")
+        got = (f"an array of shape {blocks.shape}" if blocks.ndim else f"{type(waypoints).__name__} "
+               f"{reprlib.repr(waypoints)}")
+        raise ParameterError(f"waypoints must hold (n, 4, 2) non-negative integer block cells, got {got}")
     own_map = getattr(waypoints, "occupancy", None)
     if own_map is not None:
         shape = np.shape(own_map)

@@ -8,17 +8,19 @@ stay in [π/2, 3π/2], so each relative turn is unambiguous.
 
 A *hinge state* is a triple of hinge angles in units of π/2, each 1, 2 or 3. The 23 triples whose
 blocks occupy four distinct cells are the robot's *states*; the first seven are the named
-morphologies of Table 1 of Cheng et al. 2020 (I, O, L, J, Z, S, T), the rest are the intermediate states seed
-004's single-block commands pass through, named ``h`` + the triple (e.g. ``h213``).
+morphologies of Table 1 of Cheng et al. 2020 (I, O, L, J, Z, S, T), the rest are the intermediate states
+Cheng et al. 2019's single-block commands pass through, named ``h`` + the triple (e.g. ``h213``).
 """
 
 from __future__ import annotations
 
 import itertools
 import math
+import reprlib
 
 import numpy as np
 
+from collections.abc import Sequence
 from typing import NamedTuple
 
 from htetro_opt._validation import check_int
@@ -34,6 +36,7 @@ __all__ = [
     "N_HEADINGS",
     "FOOTPRINTS",
     "shape_index",
+    "as_pose",
     "block_poses",
     "rotate_cells",
 ]
@@ -88,8 +91,18 @@ def block_poses(hinges, heading=0.0):
     >>> np.rint(centres).astype(int).tolist()
     [[0, -1], [0, 0], [1, 0], [1, -1]]
     """
-    hinges = np.asarray(hinges, dtype=float)
-    heading = np.broadcast_to(np.asarray(heading, dtype=float), hinges.shape[:-1])
+    try:
+        hinges = np.asarray(hinges, dtype=float)
+        if hinges.ndim == 0 or hinges.shape[-1] != 3:
+            raise ValueError
+    except (TypeError, ValueError) as err:
+        raise ParameterError(f"hinges must be an array of hinge-angle triples, shape (..., 3), "
+                             f"got {reprlib.repr(hinges)}") from err
+    try:
+        heading = np.broadcast_to(np.asarray(heading, dtype=float), hinges.shape[:-1])
+    except (TypeError, ValueError) as err:
+        raise ParameterError(f"heading must be a number or an array of shape {hinges.shape[:-1]}, "
+                             f"got {reprlib.repr(heading)}") from err
     turn1 = hinges[..., 0] - math.pi / 2
     turn3 = math.pi / 2 - hinges[..., 1]
     turn4 = hinges[..., 2] - math.pi / 2
@@ -160,48 +173,86 @@ def shape_index(name: str) -> int:
     --------
     >>> shape_index("O")
     1
+    >>> shape_index("Q")
+    Traceback (most recent call last):
+    ...
+    htetro_opt.errors.UnknownShapeError: unknown shape 'Q': expected one of I, O, L, J, Z, S, T (or an intermediate state such as h112 with Cheng et al. 2019's block commands)
     """
     try:
         return _STATE_INDEX[name]
     except (KeyError, TypeError) as err:
         raise UnknownShapeError(
-            f"unknown shape {name!r}: expected one of {', '.join(SHAPES)}"
+            f"unknown shape {name!r}: expected one of {', '.join(SHAPES)} (or an intermediate state such as "
+            f"{STATE_NAMES[N_NAMED]} with Cheng et al. 2019's block commands)"
         ) from err
 
 
-class Pose(NamedTuple):
-    """A robot configuration on the grid: B2's cell, the state name and the heading (quarter turns).
+def _pose_int(value, name: str) -> int:
+    """A pose's integer field (x, y or heading): a ConfigurationError naming it otherwise."""
+    if type(value) is int:  # the common case, checked without the option machinery
+        return value
+    try:
+        return check_int(value, f"pose {name}")
+    except ParameterError as err:  # a pose is a configuration: keep the error its callers catch
+        raise ConfigurationError(str(err)) from err
 
-    Examples
-    --------
-    >>> Pose.of(3, 4, "O", 0)
-    Pose(x=3, y=4, shape='O', heading=0)
-    """
 
+class _PoseFields(NamedTuple):
     x: int
     y: int
     shape: str
     heading: int
 
-    @classmethod
-    def of(cls, x, y, shape, heading=0) -> "Pose":
-        """A validated pose: integer cell, known shape, heading in 0…3.
 
-        Raises
-        ------
-        ConfigurationError
-            If x, y or heading are not integers or the heading is outside 0…3.
-        UnknownShapeError
-            If the shape is not a state of the robot.
-        """
-        try:
-            x, y, heading = (check_int(v, f"pose {name}") for name, v in (("x", x), ("y", y), ("heading", heading)))
-        except ParameterError as err:  # a pose is a configuration: keep the error its callers catch
-            raise ConfigurationError(str(err)) from err
+class Pose(_PoseFields):
+    """A robot configuration on the grid: B2's cell, the state name and the heading (quarter turns).
+
+    Every pose is validated when it is made, whichever way (``Pose(...)``, :meth:`of`,
+    :meth:`from_q`, ``_replace``): integer coordinates, a known state, a heading in 0…3. Integer
+    types such as ``numpy.int64`` become plain ints.
+
+    Raises
+    ------
+    ConfigurationError
+        If x, y or heading are not integers or the heading is outside 0…3.
+    UnknownShapeError
+        If the shape is not a state of the robot.
+
+    Examples
+    --------
+    >>> Pose(3, 4, "O", 0)
+    Pose(x=3, y=4, shape='O', heading=0)
+    >>> Pose(3, 4, "O", 4)
+    Traceback (most recent call last):
+    ...
+    htetro_opt.errors.ConfigurationError: pose heading must be 0, 1, 2 or 3 (quarter turns), got 4
+    """
+
+    __slots__ = ()
+
+    def __new__(cls, x, y, shape, heading=0):
+        if type(shape) is not str or shape not in _STATE_INDEX:
+            shape_index(shape)  # raises, naming the shape
+            shape = str(shape)  # a str subclass such as numpy.str_
+        x, y, heading = _pose_int(x, "x"), _pose_int(y, "y"), _pose_int(heading, "heading")
         if not 0 <= heading < N_HEADINGS:
             raise ConfigurationError(f"pose heading must be 0, 1, 2 or 3 (quarter turns), got {heading}")
-        shape_index(shape)
-        return cls(int(x), int(y), str(shape), int(heading))
+        return tuple.__new__(cls, (x, y, shape, heading))
+
+    @classmethod
+    def _make(cls, iterable) -> "Pose":  # namedtuple's own skips __new__ (and ``_replace`` uses it)
+        return cls(*iterable)
+
+    @classmethod
+    def of(cls, x, y, shape, heading=0) -> "Pose":
+        """A validated pose, the heading 0 unless given (the same checks as ``Pose(...)``).
+
+        Examples
+        --------
+        >>> Pose.of(3, 4, "O")
+        Pose(x=3, y=4, shape='O', heading=0)
+        """
+        return cls(x, y, shape, heading)
 
     @classmethod
     def from_q(cls, q) -> "Pose":
@@ -218,13 +269,17 @@ class Pose(NamedTuple):
 
         Examples
         --------
-        >>> Pose.from_q((3, 4, 0, 0, -np.pi, -np.pi))  # seed 004's O-shape
+        >>> Pose.from_q((3, 4, 0, 0, -np.pi, -np.pi))  # Cheng et al. 2019's O-shape
         Pose(x=3, y=4, shape='O', heading=0)
         """
-        x, y, *angles = q
-        if len(angles) != 4:
-            raise ConfigurationError(f"q must be (x, y, θB1, θB2, θB3, θB4), got {len(angles) + 2} values")
-        quarters = np.asarray(angles, dtype=float) / (math.pi / 2)
+        try:
+            x, y, *angles = q
+            if len(angles) != 4:
+                raise ValueError
+            quarters = np.asarray(angles, dtype=float) / (math.pi / 2)
+        except (TypeError, ValueError) as err:
+            raise ConfigurationError(f"q must be six numbers (x, y, θB1, θB2, θB3, θB4), "
+                                     f"got {reprlib.repr(q)}") from err
         if not np.allclose(quarters, np.rint(quarters), atol=1e-9):
             raise ConfigurationError(f"block angles must be multiples of π/2, got {list(angles)}")
         b1, b2, b3, b4 = (int(v) for v in np.rint(quarters))
@@ -234,7 +289,7 @@ class Pose(NamedTuple):
                 f"q {tuple(q)} has hinge angles {tuple(h * 90 for h in hinges)}° outside [90°, 270°] "
                 "or overlapping blocks"
             )
-        return cls.of(int(x), int(y), STATE_NAMES[_STATE_BY_HINGES[hinges]], b2 % N_HEADINGS)
+        return cls(x, y, STATE_NAMES[_STATE_BY_HINGES[hinges]], b2 % N_HEADINGS)
 
     @property
     def q(self) -> tuple[int, int, float, float, float, float]:
@@ -251,3 +306,37 @@ class Pose(NamedTuple):
 
     def as_dict(self) -> dict:
         return {"x": self.x, "y": self.y, "shape": self.shape, "heading": self.heading}
+
+
+def as_pose(value, name: str = "pose") -> Pose:
+    """``value`` as a :class:`Pose`: a Pose as it is, or a sequence ``(x, y, shape[, heading])``.
+
+    The one check of every argument that takes a pose (a start, a goal, a roadmap's entries).
+
+    Raises
+    ------
+    ConfigurationError
+        Naming ``name``, if ``value`` is not a pose or a sequence of three or four fields, or a
+        field is invalid.
+    UnknownShapeError
+        Naming ``name``, if the shape is not a state of the robot.
+
+    Examples
+    --------
+    >>> as_pose((1, 2, "O"))
+    Pose(x=1, y=2, shape='O', heading=0)
+    >>> as_pose("O", "start")
+    Traceback (most recent call last):
+    ...
+    htetro_opt.errors.ConfigurationError: start must be a Pose or (x, y, shape, heading), got 'O'
+    """
+    if isinstance(value, Pose):
+        return value
+    if isinstance(value, (str, bytes)) or not isinstance(value, (Sequence, np.ndarray)) or len(value) not in (3, 4):
+        raise ConfigurationError(f"{name} must be a Pose or (x, y, shape, heading), got {reprlib.repr(value)}")
+    try:
+        return Pose(*value) if len(value) == 4 else Pose(*value, 0)
+    except UnknownShapeError as err:
+        raise UnknownShapeError(f"{name}: {err}") from err
+    except ConfigurationError as err:
+        raise ConfigurationError(f"{name}: {err}") from err

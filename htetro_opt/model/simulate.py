@@ -16,29 +16,177 @@ times t and t + 1.
 
 from __future__ import annotations
 
+import math
+import os
+import reprlib
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Iterable, Sequence
 
 import numpy as np
 
-from htetro_opt._validation import check_int
-from htetro_opt.errors import ConfigurationError, ParameterError, UnknownCommandError
+from htetro_opt._validation import check_bool, check_int
+from htetro_opt.errors import ConfigurationError, ParameterError, PlanningError, UnknownCommandError
 from htetro_opt.model.commands import (
     COMMANDS,
     N_COMMANDS,
     TOKENS,
     Timing,
+    _token_list,
     command_id,
     command_set,
 )
-from htetro_opt.model.robot import N_HEADINGS, N_NAMED, N_STATES, STATE_NAMES, Pose, shape_index
+from htetro_opt.model.robot import N_HEADINGS, N_NAMED, N_STATES, STATE_NAMES, Pose, as_pose, shape_index
 from htetro_opt.model.sweeps import SweepTables, sweep_tables
-from htetro_opt.model.workspace import Workspace
+from htetro_opt.model.workspace import Workspace, check_workspace, describe_cells
 
-__all__ = ["Simulator", "SimulationResult", "simulate"]
+__all__ = ["Simulator", "SimulationResult", "simulate", "MEMORY_BUDGET", "memory_budget", "table_shape",
+           "compile_bytes", "cells_within", "map_text", "size_text", "check_memory"]
 
 _STOP = command_id("stop")
+
+MEMORY_BUDGET = 4 * 2**30
+"""Most bytes the simulator's tables (and the exact planner's graph over them) may take, 4 GiB: the
+budget is this or half the machine's physical memory, whichever is smaller (:func:`memory_budget`).
+A map that would need more is refused before anything is allocated, with what would fit."""
+
+_ROWS_PER_SORT = 1 << 16
+"""Poses whose valid commands the repair sorts at a time (bounds the sort's temporary arrays)."""
+
+_BUDGET_TEXT = "the smaller of htetro_opt.model.simulate.MEMORY_BUDGET and half the physical memory"
+
+
+def memory_budget() -> int:
+    """Bytes the tables of one simulator (and a search over them) may take: :data:`MEMORY_BUDGET`,
+    or half the physical memory where that is less (``os.sysconf``; where it is unknown, the
+    constant alone).
+
+    Examples
+    --------
+    >>> 0 < memory_budget() <= MEMORY_BUDGET
+    True
+    """
+    try:
+        physical = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (AttributeError, ValueError, OSError):  # not a POSIX system, or the names are unknown
+        return MEMORY_BUDGET
+    return min(MEMORY_BUDGET, physical // 2) if physical > 0 else MEMORY_BUDGET
+
+
+def _resolve_commands(commands, diagonals: bool) -> tuple[int, ...]:
+    """Global ids of a simulator's command set: the default (with ``diagonals``), tokens or ids."""
+    diagonals = check_bool(diagonals, "diagonals")
+    if commands is None:
+        return command_set(diagonals=diagonals)
+    if isinstance(commands, str):
+        return command_set(tokens=commands)
+    listed = _token_list(commands, "commands")
+    if all(isinstance(c, str) for c in listed):
+        return command_set(tokens=listed)
+    try:
+        listed = [check_int(c, "command id", minimum=0, maximum=N_COMMANDS - 1) for c in listed]
+    except ParameterError as err:
+        raise UnknownCommandError(f"a command set is all tokens or all command ids: {err}") from err
+    return command_set(tokens=[TOKENS[c] for c in listed])
+
+
+def _states_of(ids) -> int:
+    """Number of robot states a command set reaches: the intermediate ones only with block commands."""
+    uses_blocks = any(COMMANDS[c].kind == "block" and any(COMMANDS[c].hinge_delta) for c in ids)
+    return N_STATES if uses_blocks else N_NAMED
+
+
+def table_shape(workspace: Workspace, *, commands=None, diagonals: bool = False) -> tuple[int, int]:
+    """``(n_poses, n_commands)`` of the :class:`Simulator` these options compile, without compiling it.
+
+    Examples
+    --------
+    >>> table_shape(Workspace(np.zeros((10, 10), dtype=bool)))  # 7 shapes x 4 headings x 100 cells
+    (2800, 13)
+    """
+    check_workspace(workspace)
+    ids = _resolve_commands(commands, diagonals)
+    return _states_of(ids) * N_HEADINGS * workspace.height * workspace.width, len(ids)
+
+
+def _table_dtype(n_poses: int, n_commands: int):
+    return np.int32 if (n_poses + 1) * (n_commands + 1) < 2**31 else np.int64
+
+
+def compile_bytes(n_poses: int, n_commands: int, *, repair: bool = True) -> int:
+    """Peak bytes of compiling a :class:`Simulator` (and of running it) for ``n_poses`` poses and
+    ``n_commands`` commands.
+
+    The peak is the transition table (``(n_poses + 1) x (n_commands + 1)`` int32, int64 past 2³¹
+    entries) and, from the first run, the table premultiplied by its column count, one more table of
+    the same size; plus, per pose and command, one byte of the bool validity table the table is built
+    from or, with ``repair`` (runs that repair, as the GAs' do), the two bytes of every pose's valid
+    commands (int16), sorted a slice of poses at a time (tests/model/test_simulate.py compares this
+    with tracemalloc's peak).
+
+    Examples
+    --------
+    >>> round(compile_bytes(28_000_000, 13) / 10**6)  # bytes a cell of a 1000 x 1000 map, 28 poses a cell
+    4237
+    """
+    entries = (n_poses + 1) * (n_commands + 1)
+    tables = 2 * entries * np.dtype(_table_dtype(n_poses, n_commands)).itemsize
+    if not repair:
+        return tables + n_poses * n_commands
+    sorting = 10 * min(n_poses, _ROWS_PER_SORT) * n_commands  # argsort's int64 result and its bool input
+    return tables + 3 * n_poses * n_commands + sorting
+
+
+def cells_within(bytes_for_cells, budget: int | None = None) -> int:
+    """The most cells ``c`` with ``bytes_for_cells(c) <= budget`` (default :func:`memory_budget`);
+    ``bytes_for_cells`` must grow with ``c``.
+
+    Examples
+    --------
+    >>> cells_within(lambda c: 1000 * c, budget=10**6)
+    1000
+    """
+    budget = memory_budget() if budget is None else budget
+    lo, hi = 0, 1
+    while bytes_for_cells(hi) <= budget:
+        lo, hi = hi, hi * 2
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        lo, hi = (mid, hi) if bytes_for_cells(mid) <= budget else (lo, mid)
+    return lo
+
+
+def map_text(cells: int) -> str:
+    """"a map of at most N cells (e.g. s x s)", for the messages of :func:`check_memory`'s callers."""
+    side = math.isqrt(cells)
+    return f"a map of at most {cells:,} cells (e.g. {side} x {side})"
+
+
+def check_memory(needed: int, what: str, advice: str) -> None:
+    """Refuse, before allocating, tables that would take more than :func:`memory_budget`.
+
+    Raises
+    ------
+    PlanningError
+        Saying what would need how much memory, the budget, and ``advice`` (what would fit).
+    """
+    budget = memory_budget()
+    if needed > budget:
+        raise PlanningError(f"{what} would need about {size_text(needed)} of memory, more than the budget of "
+                            f"{size_text(budget)} ({_BUDGET_TEXT}): {advice}")
+
+
+def size_text(n: int) -> str:
+    """A number of bytes for a message, in GiB from 1 GiB up, in MiB below.
+
+    Examples
+    --------
+    >>> size_text(3 * 2**29), size_text(2**40)
+    ('1.5 GiB', '1024.0 GiB')
+    >>> size_text(2**20)
+    '1.0 MiB'
+    """
+    return f"{n / 2**30:.1f} GiB" if n >= 2**30 else f"{n / 2**20:.1f} MiB"
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,7 +259,7 @@ class Simulator:
     workspace : Workspace
     commands : iterable of str or int, optional, keyword-only
         Command tokens or ids the sequences may use; Cheng et al. 2020's set by default (plus the
-        diagonals when ``diagonals``). Seed 004's block commands bring in the 16 intermediate states.
+        diagonals when ``diagonals``). Cheng et al. 2019's block commands bring in the 16 intermediate states.
     diagonals : bool, keyword-only
         Add the four diagonal translations to the default set.
     timing : Timing, keyword-only
@@ -136,30 +284,27 @@ class Simulator:
         timing: Timing | None = None,
         clearance: float = 0.0,
     ) -> None:
-        if not isinstance(workspace, Workspace):
-            raise TypeError(f"workspace must be a Workspace, got {type(workspace).__name__}")
-        if commands is None:
-            ids = command_set(diagonals=diagonals)
-        else:
-            listed = list(commands)
-            if all(isinstance(c, str) for c in listed):
-                ids = command_set(tokens=listed)
-            else:
-                try:
-                    listed = [check_int(c, "command id", minimum=0, maximum=N_COMMANDS - 1) for c in listed]
-                except ParameterError as err:
-                    raise UnknownCommandError(f"a command set is all tokens or all command ids: {err}") from err
-                ids = command_set(tokens=[TOKENS[c] for c in listed])
+        check_workspace(workspace)
+        ids = _resolve_commands(commands, diagonals)
+        if timing is not None and not isinstance(timing, Timing):
+            raise ParameterError(f"timing must be a Timing or None, got {type(timing).__name__} {reprlib.repr(timing)}")
         self.workspace = workspace
         self.timing = timing if timing is not None else Timing()
-        self.tables: SweepTables = sweep_tables(float(clearance))
+        self.tables: SweepTables = sweep_tables(clearance)
         self.command_ids = np.array(ids, dtype=np.int64)
         self.n_commands = len(ids)
         self.pad = self.n_commands
         self.n_columns = self.n_commands + 1
-        uses_blocks = any(COMMANDS[c].kind == "block" and any(COMMANDS[c].hinge_delta) for c in ids)
-        self.n_states = N_STATES if uses_blocks else N_NAMED
+        self.n_states = _states_of(ids)
         self.n_poses = self.n_states * N_HEADINGS * workspace.height * workspace.width
+        per_cell = self.n_states * N_HEADINGS
+        check_memory(
+            compile_bytes(self.n_poses, self.n_commands),
+            f"the simulator's tables for this {workspace.width} x {workspace.height} map ({per_cell} poses a cell, "
+            f"{self.n_commands} commands)",
+            f"they fit {map_text(cells_within(lambda c: compile_bytes(c * per_cell, self.n_commands)))} with these "
+            "commands; use a smaller map or coarser cells",
+        )
         self.dead = self.n_poses
         self.local = np.full(N_COMMANDS, -1, dtype=np.int64)
         self.local[self.command_ids] = np.arange(self.n_commands)
@@ -191,8 +336,9 @@ class Simulator:
     def _transition_table(self) -> np.ndarray:
         t, ws = self.tables, self.workspace
         h, w, S, C = ws.height, ws.width, self.n_states, self.n_commands
-        dtype = np.int32 if (self.n_poses + 1) * self.n_columns < 2**31 else np.int64
-        ok = self._valid_table(~ws.occupancy).transpose(0, 1, 3, 4, 2)  # (S, 4, H, W, C)
+        dtype = _table_dtype(self.n_poses, self.n_commands)
+        blocked = self._valid_table(~ws.occupancy).transpose(0, 1, 3, 4, 2)  # (S, 4, H, W, C)
+        np.logical_not(blocked, out=blocked)
         target_state = t.next_state[:S][:, self.command_ids].clip(0)  # (S, C)
         target_heading = t.next_heading[:S][:, :, self.command_ids]  # (S, 4, C)
         dx, dy = t.shift[self.command_ids, 0], t.shift[self.command_ids, 1]
@@ -203,7 +349,7 @@ class Simulator:
         table = np.empty((self.n_poses + 1, self.n_columns), dtype=dtype)
         view = table[:-1, :C].reshape(S, N_HEADINGS, h, w, C)
         np.add(entry.astype(dtype)[:, :, None, None, :], cell[None, None, :, :, None], out=view)
-        np.putmask(view, ~ok, self.dead)
+        np.copyto(view, self.dead, where=blocked)  # putmask would copy the strided view whole
         table[:-1, C] = np.arange(self.n_poses, dtype=dtype)
         table[-1] = self.dead
         return table
@@ -250,10 +396,11 @@ class Simulator:
         ConfigurationError
             If the pose is outside the map or its state is not used by this simulator.
         """
-        pose, ws = Pose.of(*pose), self.workspace
+        pose, ws = as_pose(pose), self.workspace
         s = shape_index(pose.shape)
         if s >= self.n_states:
-            raise ConfigurationError(f"state {pose.shape!r} needs seed 004's block commands")
+            raise ConfigurationError(f"state {pose.shape!r} is an intermediate state: it needs Cheng et al. 2019's "
+                                     "block commands (1l, 1r, 3l, 3r, 4l, 4r) in the simulator's command set")
         if not ws.contains(pose.x, pose.y):
             raise ConfigurationError(f"pose ({pose.x}, {pose.y}) lies outside the {ws.width} x {ws.height} map")
         return int(((s * N_HEADINGS + pose.heading) * ws.height + pose.y) * ws.width + pose.x)
@@ -285,6 +432,7 @@ class Simulator:
             Naming ``what`` (e.g. "start") and the offending cells if the pose lies outside the map or
             collides.
         """
+        pose = as_pose(pose, what)
         try:
             pid = self.encode(pose)
         except ConfigurationError as err:
@@ -294,7 +442,8 @@ class Simulator:
             margin = f" (with clearance {self.tables.clearance:g})" if self.tables.clearance else ""
             when = "" if t is None else f" at time {t}"
             raise ConfigurationError(
-                f"{what} {tuple(pose)}{margin} collides with obstacles or the map edge{when} at cells {conflicts}"
+                f"{what} {tuple(pose)}{margin} collides with obstacles or the map edge{when} "
+                f"at {describe_cells(conflicts)}"
             )
         return pid
 
@@ -302,15 +451,21 @@ class Simulator:
     def _local_commands(self, sequences) -> tuple[np.ndarray, np.ndarray]:
         """Sequences of global ids as one (B, L) array of local columns, padded with ``pad``."""
         if isinstance(sequences, np.ndarray) and sequences.ndim == 2:
+            if sequences.size and not np.issubdtype(sequences.dtype, np.integer):
+                raise ParameterError(f"sequences must hold integer command ids, got an array of {sequences.dtype}")
             ids = sequences.astype(np.int64, copy=False)
             lengths = np.full(len(ids), ids.shape[1], dtype=np.int64)
             present = None
         else:
-            sequences = list(sequences)
-            lengths = np.fromiter((len(s) for s in sequences), dtype=np.int64, count=len(sequences))
+            if isinstance(sequences, (str, bytes)) or not isinstance(sequences, Iterable):
+                raise ParameterError(
+                    "sequences must be a batch of command-id sequences (e.g. [parse_commands('x+,y+')]), "
+                    f"got {type(sequences).__name__} {reprlib.repr(sequences)}")
+            arrays = [_command_ids(s, i) for i, s in enumerate(sequences)]
+            lengths = np.fromiter((len(a) for a in arrays), dtype=np.int64, count=len(arrays))
             width = int(lengths.max()) if len(lengths) else 0
             present = np.arange(width)[None, :] < lengths[:, None]
-            ids = np.concatenate([np.asarray(s, dtype=np.int64).ravel() for s in sequences]) if width else np.empty(0, np.int64)
+            ids = np.concatenate(arrays).astype(np.int64, copy=False) if width else np.empty(0, np.int64)
         bad = (ids < 0) | (ids >= N_COMMANDS)
         if bad.any():
             raise UnknownCommandError(f"command id {int(ids[bad][0])} is not a command")
@@ -365,8 +520,23 @@ class Simulator:
         UnknownCommandError
             If a sequence uses a command outside this simulator's set.
         """
-        start_id = start if isinstance(start, (int, np.integer)) else self.check_pose(start, what="start", t=t0)
-        goals = np.array([self.encode(p) for p in roadmap], dtype=np.int64) if roadmap else np.empty(0, np.int64)
+        t0 = check_int(t0, "t0", minimum=0)
+        stop_at_goal = check_bool(stop_at_goal, "stop_at_goal")
+        if repair is not None and not isinstance(repair, np.random.Generator):
+            raise ParameterError(f"repair must be a numpy.random.Generator or None, got {reprlib.repr(repair)}")
+        if isinstance(start, (int, np.integer)) and not isinstance(start, (bool, np.bool_)):
+            if not 0 <= start < self.n_poses:
+                raise ConfigurationError(f"start pose id {start} is not a pose id of this simulator "
+                                         f"(0…{self.n_poses - 1})")
+            start_id = int(start)
+        else:
+            start_id = self.check_pose(start, what="start", t=t0)
+        if roadmap is None:
+            roadmap = ()
+        elif isinstance(roadmap, (str, bytes, Pose)) or not isinstance(roadmap, Iterable):
+            raise ParameterError(f"roadmap must be a sequence of poses or None, got {type(roadmap).__name__} "
+                                 f"{reprlib.repr(roadmap)}")
+        goals = np.array([self.encode(as_pose(p, f"roadmap[{i}]")) for i, p in enumerate(roadmap)], dtype=np.int64)
         local, lengths = self._local_commands(sequences)
         keys, local = self._step_all(local, lengths, start_id * self.n_columns, t0, repair)
         return self._summarise(keys, local, lengths, goals * self.n_columns, stop_at_goal)
@@ -410,9 +580,14 @@ class Simulator:
     @cached_property
     def _valid_columns(self) -> tuple[np.ndarray, np.ndarray]:
         """Per pose, its valid command columns first (``(n_poses, C)``) and how many there are."""
-        valid = self.next[: self.n_poses, : self.n_commands] != self.dead
-        order = np.argsort(~valid, axis=1, kind="stable").astype(np.int16)
-        return order, valid.sum(axis=1)
+        order = np.empty((self.n_poses, self.n_commands), dtype=np.int16)
+        counts = np.empty(self.n_poses, dtype=np.int16)
+        table, step = self.next[: self.n_poses, : self.n_commands], _ROWS_PER_SORT
+        for lo in range(0, self.n_poses, step):  # in slices: argsort's int64 result is 4 times the int16 kept
+            invalid = table[lo : lo + step] == self.dead
+            order[lo : lo + step] = np.argsort(invalid, axis=1, kind="stable")
+            counts[lo : lo + step] = self.n_commands - invalid.sum(axis=1)
+        return order, counts
 
     def _repair_step(self, t: int, steps: np.ndarray, keys: np.ndarray, blocked: np.ndarray | None,
                      rng: np.random.Generator) -> None:
@@ -480,6 +655,20 @@ class Simulator:
             keys=keys,
             local=local,
         )
+
+
+def _command_ids(sequence, i: int) -> np.ndarray:
+    """One sequence of a batch as a flat integer array of command ids."""
+    if isinstance(sequence, np.ndarray) and sequence.dtype.kind in "iu":  # the GAs' case, checked first
+        return sequence.ravel()
+    try:
+        array = np.asarray(sequence)
+    except (TypeError, ValueError):
+        array = None
+    if array is None or (array.size and not np.issubdtype(array.dtype, np.integer)) or isinstance(sequence, str):
+        raise ParameterError(f"sequences[{i}] must be a sequence of integer command ids (parse_commands turns tokens "
+                             f"into ids), got {reprlib.repr(sequence)}")
+    return array.astype(np.int64, copy=False).ravel()
 
 
 def simulate(workspace: Workspace, sequences, start: Pose, **options) -> SimulationResult:

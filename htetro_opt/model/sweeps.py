@@ -5,11 +5,11 @@ of its continuous motion is inside the map and free. The motion of each command 
 (at most 2° of block turn between samples, 16 samples per cell of translation) and, at each sample,
 the cells a block square overlaps are found exactly by the separating-axis test. The result, for every
 (state, heading, command), is an integer array of cell offsets from B2's start cell: the model's AAT /
-VAT tables (seed 004), so that the hot path checks validity by table lookup only.
+VAT tables (Cheng et al. 2019), so that the hot path checks validity by table lookup only.
 
 Motions are computed at heading 0 and turned for the other headings: a turned robot's sweep is the
 turned sweep, and a translation at heading k is the turned sweep of the translation by the
-counter-turned shift at heading 0. Seed-004 single-block commands are legal only when the end hinge
+counter-turned shift at heading 0. Cheng et al. 2019's single-block commands are legal only when the end hinge
 state is one of the robot's 23 states (hinges within [π/2, 3π/2], no two blocks on one cell) and no
 two non-neighbouring blocks overlap during the motion; shapeshifts, translations and rotations are
 always legal.

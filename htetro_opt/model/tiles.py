@@ -1,10 +1,10 @@
-"""Tetromino tiles and the robot poses that fill them (seed 003 §3.1, shared/MODEL.md §2).
+"""Tetromino tiles and the robot poses that fill them (Le et al. 2018, §3.1; shared/MODEL.md §2).
 
 A *tile* is a set of four free cells covered by the robot in one of its seven morphologies. The
 robot's footprints (:data:`~htetro_opt.model.robot.FOOTPRINTS`) give each morphology 1 (O), 2 (I, S, Z)
 or 4 (L, J, T) distinct cell patterns, 19 in all: the fixed tetrominoes. A pattern is filled by the
 poses whose footprint covers exactly its cells: one pose for L, J and T, two for I, S and Z, four for
-O. Seed 003 calls these the block-location *options* of a tiling pattern (its Figs. 7 and 8).
+O. Le et al. 2018 call these the block-location *options* of a tiling pattern (its Figs. 7 and 8).
 
 Scan order is the order the paper's Algorithm 1 numbers tiles in: the top row first, each row from
 left to right, i.e. by ``(-y, x)``.
@@ -12,11 +12,13 @@ left to right, i.e. by ``(-y, x)``.
 
 from __future__ import annotations
 
+import reprlib
+from collections.abc import Iterable
 from typing import NamedTuple
 
 import numpy as np
 
-from htetro_opt.errors import ConfigurationError
+from htetro_opt.errors import ConfigurationError, ParameterError
 from htetro_opt.model.robot import FOOTPRINTS, N_HEADINGS, SHAPES, Pose, shape_index
 
 __all__ = ["Pattern", "PATTERNS", "patterns_of", "identify_tile", "tile_poses", "scan_key"]
@@ -82,7 +84,10 @@ def patterns_of(shapes=None) -> tuple[Pattern, ...]:
     UnknownShapeError
         If a name is not a state of the robot.
     ConfigurationError
-        If a name is one of seed 004's intermediate states, which tile nothing.
+        If a name is one of the intermediate states (of Cheng et al. 2019's block commands), which
+        tile nothing.
+    ParameterError
+        If ``shapes`` is not a string or a sequence of names.
 
     Examples
     --------
@@ -91,12 +96,28 @@ def patterns_of(shapes=None) -> tuple[Pattern, ...]:
     """
     if shapes is None:
         return PATTERNS
+    if isinstance(shapes, bytes) or not isinstance(shapes, Iterable):
+        raise ParameterError(f"shapes must be morphology names such as 'TZ' or ['O'], "
+                             f"got {type(shapes).__name__} {reprlib.repr(shapes)}")
     wanted = set()
     for name in shapes:
         if shape_index(name) >= len(SHAPES):
-            raise ConfigurationError(f"{name!r} is an intermediate state, not a tile shape ({', '.join(SHAPES)})")
+            raise ConfigurationError(f"{name!r} is an intermediate state (of Cheng et al. 2019's block commands), "
+                                 f"not a tile shape ({', '.join(SHAPES)})")
         wanted.add(name)
     return tuple(p for p in PATTERNS if p.shape in wanted)
+
+
+def _cell_array(cells) -> np.ndarray:
+    """(x, y) integer pairs as an (n, 2) int64 array."""
+    try:
+        array = np.asarray(cells)
+        ok = array.size == 0 or (np.issubdtype(array.dtype, np.integer) and array.ndim >= 1 and array.shape[-1] == 2)
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ConfigurationError(f"cells must be (x, y) integer pairs, got {reprlib.repr(cells)}")
+    return array.astype(np.int64, copy=False).reshape(-1, 2)
 
 
 def identify_tile(cells) -> Pattern | None:
@@ -108,8 +129,13 @@ def identify_tile(cells) -> Pattern | None:
     'O'
     >>> identify_tile([(0, 0), (2, 0), (3, 0), (4, 0)]) is None
     True
+
+    Raises
+    ------
+    ConfigurationError
+        If ``cells`` are not (x, y) integer pairs.
     """
-    cells = sorted(map(tuple, np.asarray(cells, dtype=np.int64).reshape(-1, 2).tolist()), key=scan_key)
+    cells = sorted(map(tuple, _cell_array(cells).tolist()), key=scan_key)
     if len(cells) != 4:
         return None
     first = np.array(cells[0])
@@ -132,7 +158,7 @@ def tile_poses(cells) -> tuple[Pose, ...]:
     pattern = identify_tile(cells)
     if pattern is None:
         raise ConfigurationError(f"cells {np.asarray(cells).tolist()} are not a tetromino")
-    first = min(map(tuple, np.asarray(cells, dtype=np.int64).tolist()), key=scan_key)
+    first = min(map(tuple, _cell_array(cells).tolist()), key=scan_key)
     return tuple(
         Pose(int(first[0] + a[0]), int(first[1] + a[1]), pattern.shape, h)
         for h, a in zip(pattern.headings, pattern.anchors)

@@ -8,16 +8,17 @@ route by ``speed`` cells per command executed (time index t = number of commands
 from __future__ import annotations
 
 import math
+import reprlib
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from htetro_opt._validation import check_int, check_real
+from htetro_opt._validation import check_bool, check_int, check_real
 from htetro_opt.errors import ConfigurationError, ParameterError, ScenarioError
 
-__all__ = ["Workspace", "MovingObstacle", "grid_distance"]
+__all__ = ["Workspace", "MovingObstacle", "grid_distance", "check_workspace", "describe_cells"]
 
 
 @dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
@@ -45,8 +46,7 @@ class MovingObstacle:
     _steps: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        cells = np.asarray(self.cells, dtype=np.int64).reshape(-1, 2)
-        route = np.asarray(self.route, dtype=np.int64).reshape(-1, 2)
+        cells, route = _cell_pairs(self.cells, "cells"), _cell_pairs(self.route, "route")
         if len(cells) == 0:
             raise ScenarioError("a moving obstacle needs at least one cell")
         if len(route) == 0 or route[0].any():
@@ -118,9 +118,12 @@ class Workspace:
     moving: tuple[MovingObstacle, ...] = ()
 
     def __post_init__(self) -> None:
-        occ = np.array(self.occupancy, dtype=bool)
-        if occ.ndim != 2 or occ.shape[0] == 0 or occ.shape[1] == 0:
-            raise ScenarioError(f"occupancy must be a non-empty 2-D array, got shape {occ.shape}")
+        occ = _occupancy(self.occupancy)
+        moving = self.moving
+        if isinstance(moving, MovingObstacle):
+            moving = (moving,)
+        if not isinstance(moving, (tuple, list)) or not all(isinstance(m, MovingObstacle) for m in moving):
+            raise ScenarioError(f"moving must be a sequence of MovingObstacle, got {reprlib.repr(self.moving)}")
         try:
             cell_size = check_real(self.cell_size, "cell_size", minimum=0.0, include_minimum=False)
         except ParameterError as err:  # maps come from scenario files: the loader's error
@@ -128,7 +131,7 @@ class Workspace:
         object.__setattr__(self, "cell_size", cell_size)
         occ.setflags(write=False)
         object.__setattr__(self, "occupancy", occ)
-        object.__setattr__(self, "moving", tuple(self.moving))
+        object.__setattr__(self, "moving", tuple(moving))
 
     @property
     def width(self) -> int:
@@ -196,6 +199,77 @@ class Workspace:
         return Workspace(self.occupancy, self.cell_size)
 
 
+def _occupancy(value) -> np.ndarray:
+    """An occupancy grid as a fresh bool array: booleans, or numbers that are all 0 or 1."""
+    try:
+        occ = np.array(value)
+    except (TypeError, ValueError):
+        occ = None
+    if occ is not None and occ.dtype != bool:
+        if occ.ndim != 2 or not np.issubdtype(occ.dtype, np.number) or not np.isin(occ, (0, 1)).all():
+            occ = None
+        else:
+            occ = occ.astype(bool)
+    if occ is None or occ.ndim != 2 or occ.shape[0] == 0 or occ.shape[1] == 0:
+        got = (f"shape {occ.shape}" if occ is not None and occ.dtype == bool
+               else f"{type(value).__name__} {reprlib.repr(value)}")
+        raise ScenarioError(f"occupancy must be a non-empty 2-D array of booleans (True = obstacle) or 0/1, got {got}")
+    return occ
+
+
+def _cell_pairs(value, name: str) -> np.ndarray:
+    """(x, y) integer pairs as an (n, 2) int64 array."""
+    try:
+        array = np.asarray(value)
+        ok = array.size == 0 or (np.issubdtype(array.dtype, np.integer) and array.ndim <= 2 and array.size % 2 == 0
+                                 and (array.ndim < 2 or array.shape[-1] == 2))
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ScenarioError(f"moving obstacle {name} must be (x, y) integer pairs, got {reprlib.repr(value)}")
+    return array.astype(np.int64).reshape(-1, 2)
+
+
+def describe_cells(cells, limit: int = 5) -> str:
+    """A short text of some (x, y) cells for a message: how many, and at most ``limit`` of them.
+
+    Examples
+    --------
+    >>> describe_cells([(0, 0)]), describe_cells([(0, 0), (1, 0)])
+    ('cell (0, 0)', '2 cells (0, 0), (1, 0)')
+    >>> describe_cells([(x, 0) for x in range(40)], limit=3)
+    '40 cells (0, 0), (1, 0), (2, 0) and 37 more'
+    """
+    pairs = [(int(x), int(y)) for x, y in np.asarray(cells).reshape(-1, 2).tolist()]
+    if len(pairs) == 1:
+        return f"cell {pairs[0]}"
+    shown = ", ".join(map(str, pairs[:limit]))
+    more = f" and {len(pairs) - limit} more" if len(pairs) > limit else ""
+    return f"{len(pairs)} cells {shown}{more}"
+
+
+def check_workspace(workspace, name: str = "workspace", *, what: str = "a Workspace") -> "Workspace":
+    """``workspace`` itself if it is a :class:`Workspace`: the one check of every argument that takes one
+    (``what`` says what the argument may be, for one that also takes a compiled simulator).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``name`` and what it got.
+
+    Examples
+    --------
+    >>> check_workspace("map.toml")
+    Traceback (most recent call last):
+    ...
+    htetro_opt.errors.ParameterError: workspace must be a Workspace (e.g. Workspace(occupancy), or a scenario's .workspace), got str 'map.toml'
+    """
+    if not isinstance(workspace, Workspace):
+        raise ParameterError(f"{name} must be {what} (e.g. Workspace(occupancy), or a scenario's .workspace), "
+                             f"got {type(workspace).__name__} {reprlib.repr(workspace)}")
+    return workspace
+
+
 def grid_distance(workspace: Workspace, goal: tuple[int, int], *, diagonals: bool = False) -> np.ndarray:
     """Shortest path length from every free cell to ``goal`` over free cells (MODEL.md §5, W_A*).
 
@@ -217,14 +291,22 @@ def grid_distance(workspace: Workspace, goal: tuple[int, int], *, diagonals: boo
     Raises
     ------
     ConfigurationError
-        If the goal cell is outside the map or on an obstacle.
+        If the goal cell is not a pair of integers, outside the map or on an obstacle.
+    ParameterError
+        If ``workspace`` is not a Workspace or ``diagonals`` not True or False.
 
     Examples
     --------
     >>> grid_distance(Workspace(np.zeros((1, 3), dtype=bool)), (0, 0)).tolist()
     [[0.0, 1.0, 2.0]]
     """
-    gx, gy = goal
+    check_workspace(workspace)
+    diagonals = check_bool(diagonals, "diagonals")
+    try:
+        gx, gy = goal
+        gx, gy = check_int(gx, "goal x"), check_int(gy, "goal y")
+    except (TypeError, ValueError) as err:  # ParameterError among them
+        raise ConfigurationError(f"goal must be a cell (x, y) of integers, got {reprlib.repr(goal)}") from err
     if not workspace.is_free(gx, gy):
         raise ConfigurationError(f"goal cell ({gx}, {gy}) is outside the map or on an obstacle")
     free = ~workspace.occupancy

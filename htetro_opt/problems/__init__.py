@@ -16,6 +16,6 @@ __getattr__, __dir__, __all__ = attach(__name__, {
        ("CommandPathProblem", "FITNESS_NAMES", "SAFETY_COEFFICIENT", "SAFETY_PATTERN", "safety_field")},
     **{name: ".waypoint_sequencing" for name in
        ("DEFAULT_BLOCK_WEIGHTS", "SequencingInstance", "block_locations", "check_weights", "cost_matrix",
-        "path_cost")},
+        "path_cost", "check_instance")},
     "SequencingProblem": "._sequencing_problem",
 })

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pymoo.core.problem import Problem
 
-from htetro_opt.problems.waypoint_sequencing import SequencingInstance, path_cost
+from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance, path_cost
 
 __all__ = ["SequencingProblem"]
 
@@ -28,7 +28,7 @@ class SequencingProblem(Problem):
     """
 
     def __init__(self, instance: SequencingInstance):
-        self.instance = instance
+        self.instance = check_instance(instance)
         self._free = np.array([i for i in range(instance.n) if i != instance.start], dtype=np.int64)
         super().__init__(n_var=len(self._free), n_obj=1, xl=0, xu=max(len(self._free) - 1, 0), vtype=int)
 

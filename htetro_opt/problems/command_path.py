@@ -30,10 +30,11 @@ import numpy as np
 from pymoo.core.problem import Problem
 
 from htetro_opt._validation import check_int
+from htetro_opt.errors import ParameterError, ScenarioError
 from htetro_opt.model.commands import SEED000_COMMANDS, Timing
-from htetro_opt.model.robot import FOOTPRINTS, Pose
-from htetro_opt.model.simulate import SimulationResult, Simulator
-from htetro_opt.model.workspace import Workspace, grid_distance
+from htetro_opt.model.robot import FOOTPRINTS, Pose, as_pose
+from htetro_opt.model.simulate import SimulationResult, Simulator, check_memory, compile_bytes
+from htetro_opt.model.workspace import Workspace, check_workspace, grid_distance
 
 __all__ = [
     "CommandPathProblem",
@@ -55,6 +56,13 @@ SAFETY_COEFFICIENT = 6.0 + 2.0 * math.sqrt(2.0)
 """λ_sp: the sum of ``1 / ‖offset‖`` over :data:`SAFETY_PATTERN`, so a block walled in on all sides scores 1."""
 
 _MISCONFIGURED_AT_GOAL = 0.5  # W_A* given to a child on the goal cell in the wrong morphology or heading
+_POSES_PER_SLICE = 1 << 18  # poses whose tables are computed at a time
+
+
+def _table_bytes(n_poses: int) -> int:
+    """Peak bytes of the per-pose tables: f_gr and the safety penalty (float64 each), and the
+    temporaries of one slice of poses (measured: 217 bytes a pose)."""
+    return 16 * n_poses + 220 * min(n_poses, _POSES_PER_SLICE)
 
 
 def safety_field(occupancy: np.ndarray) -> np.ndarray:
@@ -74,8 +82,16 @@ def safety_field(occupancy: np.ndarray) -> np.ndarray:
     >>> field = safety_field(np.zeros((5, 5), dtype=bool))
     >>> float(field[2, 2]), round(float(field[0, 0]), 3)
     (0.0, 5.121)
+
+    Raises
+    ------
+    ParameterError
+        If ``occupancy`` is not a non-empty 2-D array of booleans or 0/1.
     """
-    occupancy = np.asarray(occupancy, dtype=bool)
+    try:
+        occupancy = Workspace(occupancy).occupancy
+    except ScenarioError as err:  # an argument here, not a file's content
+        raise ParameterError(str(err)) from err
     h, w = occupancy.shape
     framed = np.ones((h + 4, w + 4), dtype=bool)
     framed[2 : 2 + h, 2 : 2 + w] = occupancy
@@ -120,7 +136,11 @@ class CommandPathProblem(Problem):
     ConfigurationError
         If the start (at time ``t0``) or the goal collides or lies outside the map.
     ParameterError
-        If ``max_length`` is not a positive integer or ``t0`` is negative.
+        If ``max_length`` is not a positive integer, ``t0`` is negative, or ``workspace`` is neither
+        a Workspace nor a Simulator.
+    PlanningError
+        If the simulator's and the problem's per-pose tables would not fit the memory budget
+        (:func:`~htetro_opt.model.simulate.memory_budget`).
 
     Examples
     --------
@@ -147,14 +167,16 @@ class CommandPathProblem(Problem):
     ) -> None:
         max_length = check_int(max_length, "max_length (l_p,max)", minimum=1)
         t0 = check_int(t0, "t0", minimum=0)
+        start, goal = as_pose(start, "start"), as_pose(goal, "goal")
         if isinstance(workspace, Simulator):
             sim = workspace
         else:
+            check_workspace(workspace, what="a Workspace or a Simulator")
             sim = Simulator(workspace, commands=commands if commands is not None else SEED000_COMMANDS,
                             timing=timing, clearance=clearance)
         self.simulator = sim
-        self.start = Pose.of(*start)
-        self.goal = Pose.of(*goal)
+        self.start = start
+        self.goal = goal
         self.t0 = t0
         self.start_id = sim.check_pose(self.start, what="start", t=self.t0)
         self.goal_id = sim.check_pose(self.goal, what="goal")
@@ -162,6 +184,10 @@ class CommandPathProblem(Problem):
         self.command_ids = sim.command_ids.copy()
         self.durations = sim.timing.durations()
         self.t_max = self.max_length * sim.timing.translation
+        check_memory(_table_bytes(sim.n_poses) + compile_bytes(sim.n_poses, sim.n_commands),
+                     f"the path problem's pose tables with the simulator's for this {sim.workspace.width} x "
+                     f"{sim.workspace.height} map ({sim.n_poses // (sim.workspace.width * sim.workspace.height)} "
+                     "poses a cell)", "use a smaller map or coarser cells")
         self._pose_reachability, self._pose_danger = self._pose_tables()
         super().__init__(n_var=1, n_obj=4, vtype=object, elementwise=False)
 
@@ -170,15 +196,19 @@ class CommandPathProblem(Problem):
         sim, ws = self.simulator, self.simulator.workspace
         distance = grid_distance(ws, (self.goal.x, self.goal.y))
         danger_field = safety_field(ws.occupancy)
-        poses = sim.decode(np.arange(sim.n_poses))
-        x, y, s, h = poses.T
-        w_astar = distance[y, x].copy()
-        w_astar[(w_astar == 0) & (np.arange(sim.n_poses) != self.goal_id)] = _MISCONFIGURED_AT_GOAL
-        reachability = np.append(1.0 / (1.0 + w_astar), 0.0)
-        blocks = FOOTPRINTS[s, h] + poses[:, None, :2]  # (n_poses, 4, 2)
-        bx = blocks[..., 0].clip(0, ws.width - 1)
-        by = blocks[..., 1].clip(0, ws.height - 1)
-        danger = np.append(danger_field[by, bx].sum(axis=1), 0.0)
+        reachability = np.zeros(sim.n_poses + 1)
+        danger = np.zeros(sim.n_poses + 1)
+        for lo in range(0, sim.n_poses, _POSES_PER_SLICE):  # in slices: the temporaries are 13 times the tables
+            ids = np.arange(lo, min(lo + _POSES_PER_SLICE, sim.n_poses))
+            poses = sim.decode(ids)
+            x, y, s, h = poses.T
+            w_astar = distance[y, x]
+            w_astar[(w_astar == 0) & (ids != self.goal_id)] = _MISCONFIGURED_AT_GOAL
+            reachability[ids] = 1.0 / (1.0 + w_astar)
+            blocks = FOOTPRINTS[s, h] + poses[:, None, :2]  # (slice, 4, 2)
+            bx = blocks[..., 0].clip(0, ws.width - 1)
+            by = blocks[..., 1].clip(0, ws.height - 1)
+            danger[ids] = danger_field[by, bx].sum(axis=1)
         return reachability, danger
 
     # --- evaluation --------------------------------------------------------------------------

@@ -16,14 +16,16 @@
 
 from __future__ import annotations
 
+import reprlib
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 
 from htetro_opt._validation import check_int
-from htetro_opt.errors import ParameterError, PlanningError
+from htetro_opt.errors import ConfigurationError, ParameterError, PlanningError
 from htetro_opt.model.tiles import scan_key, tile_poses
-from htetro_opt.scenarios.tileset import Tileset
+from htetro_opt.scenarios.tileset import Tileset, check_tileset
 
 __all__ = [
     "DEFAULT_BLOCK_WEIGHTS",
@@ -32,6 +34,7 @@ __all__ = [
     "cost_matrix",
     "path_cost",
     "SequencingInstance",
+    "check_instance",
 ]
 
 DEFAULT_BLOCK_WEIGHTS = (0.25, 0.25, 0.25, 0.25)
@@ -85,9 +88,22 @@ def cost_matrix(blocks, weights=DEFAULT_BLOCK_WEIGHTS) -> np.ndarray:
     [[0.0, 3.0], [3.0, 0.0]]
     """
     w = check_weights(weights)
-    b = np.asarray(blocks, dtype=float).reshape(-1, 4, 2)
+    b = _block_cells(blocks).astype(float)
     distance = np.sqrt(((b[:, None] - b[None, :]) ** 2).sum(-1))
     return distance @ w
+
+
+def _block_cells(blocks) -> np.ndarray:
+    """Block cells as an (n, 4, 2) array of numbers."""
+    try:
+        b = np.asarray(blocks)
+        ok = b.size == 0 or (np.issubdtype(b.dtype, np.number) and b.size % 8 == 0)
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ParameterError(f"blocks must be the (n, 4, 2) cells of blocks a–d at each waypoint, got "
+                             f"{type(blocks).__name__} {reprlib.repr(blocks)}")
+    return b.reshape(-1, 4, 2)
 
 
 def path_cost(cost: np.ndarray, order) -> np.ndarray | float:
@@ -97,8 +113,28 @@ def path_cost(cost: np.ndarray, order) -> np.ndarray | float:
     --------
     >>> path_cost(np.array([[0, 1, 5], [1, 0, 2], [5, 2, 0]]), [0, 1, 2])
     3.0
+
+    Raises
+    ------
+    ParameterError
+        If ``cost`` is not a square matrix of numbers, or ``order`` not waypoint indices into it.
     """
-    order = np.asarray(order, dtype=np.int64)
+    try:
+        cost = np.asarray(cost)
+        ok = cost.ndim == 2 and cost.shape[0] == cost.shape[1] and np.issubdtype(cost.dtype, np.number)
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ParameterError(f"cost must be a square matrix of numbers, got {type(cost).__name__} {reprlib.repr(cost)}")
+    try:
+        order = np.asarray(order)
+        ok = order.ndim >= 1 and (order.size == 0 or np.issubdtype(order.dtype, np.integer))
+        ok = ok and (order.size == 0 or (order.min() >= 0 and order.max() < len(cost)))
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ParameterError(f"order must be waypoint indices in 0…{len(cost) - 1}, got {reprlib.repr(order)}")
+    order = order.astype(np.int64, copy=False)
     legs = cost[order[..., :-1], order[..., 1:]].sum(-1)
     return float(legs) if order.ndim == 1 else legs
 
@@ -124,7 +160,9 @@ def block_locations(occupancy, tiles, *, weights=DEFAULT_BLOCK_WEIGHTS, cell_siz
     Raises
     ------
     ConfigurationError
-        If a tile's cells are not a tetromino.
+        If a tile's cells are not four integer cells of a tetromino.
+    ParameterError
+        If ``tiles`` is not a sequence, or the weights are invalid.
 
     Examples
     --------
@@ -133,8 +171,16 @@ def block_locations(occupancy, tiles, *, weights=DEFAULT_BLOCK_WEIGHTS, cell_siz
     [1, 1]
     """
     w = check_weights(weights)
-    ordered = sorted((np.asarray(t, dtype=np.int64).reshape(4, 2) for t in tiles),
-                     key=lambda cells: scan_key(min(map(tuple, cells.tolist()), key=scan_key)))
+    if isinstance(tiles, (str, bytes)) or not isinstance(tiles, Iterable):
+        raise ParameterError(f"tiles must be a sequence of tiles, each four (x, y) cells, got "
+                             f"{type(tiles).__name__} {reprlib.repr(tiles)}")
+    cells_of = []
+    for i, tile in enumerate(tiles):
+        cells = _block_cells(tile) if not isinstance(tile, str) else None
+        if cells is None or cells.shape != (1, 4, 2) or not np.issubdtype(cells.dtype, np.integer):
+            raise ConfigurationError(f"tiles[{i}] must be four (x, y) integer cells, got {reprlib.repr(tile)}")
+        cells_of.append(cells[0].astype(np.int64))
+    ordered = sorted(cells_of, key=lambda cells: scan_key(min(map(tuple, cells.tolist()), key=scan_key)))
     poses = []
     previous = None
     for cells in ordered:
@@ -172,7 +218,7 @@ class SequencingInstance:
     PlanningError
         If the cost matrix is not square, non-empty and finite.
     ParameterError
-        If ``start`` is not None or a waypoint index.
+        If ``start`` is not None or a waypoint index, or an argument has the wrong type or size.
     """
 
     cost: np.ndarray
@@ -182,19 +228,35 @@ class SequencingInstance:
     shape: tuple[int, int] = (0, 0)
 
     def __post_init__(self) -> None:
-        cost = np.array(self.cost, dtype=float)
-        n = len(cost)
+        try:
+            cost = np.array(self.cost, dtype=float)
+        except (TypeError, ValueError) as err:
+            raise ParameterError(f"cost must be a square matrix of numbers, got {type(self.cost).__name__} "
+                                 f"{reprlib.repr(self.cost)}") from err
+        n = len(cost) if cost.ndim else 0
         if cost.shape != (n, n) or n == 0 or not np.isfinite(cost).all():
             raise PlanningError(f"the cost matrix must be square, non-empty and finite, got shape {cost.shape}")
         start = check_int(self.start, "start", minimum=0, maximum=n - 1, allow_none=True)
-        blocks = np.array(self.blocks, dtype=np.int64).reshape(n, 4, 2)
-        ids = tuple(self.ids) or tuple(range(1, n + 1))
+        blocks = _block_cells(self.blocks)
+        if len(blocks) != n:
+            raise ParameterError(f"blocks must hold the cells of the {n} waypoints of the cost matrix, got {len(blocks)}")
+        blocks = blocks.astype(np.int64)
+        try:
+            ids = tuple(check_int(i, "tile id") for i in self.ids) or tuple(range(1, n + 1))
+            shape = tuple(check_int(v, "grid shape (H, W)", minimum=0) for v in self.shape)
+        except TypeError as err:
+            raise ParameterError(f"ids and shape must be sequences of integers, got {reprlib.repr(self.ids)} "
+                                 f"and {reprlib.repr(self.shape)}") from err
+        if len(ids) != n or len(shape) != 2:
+            raise ParameterError(f"need one tile id per waypoint ({n}) and a grid shape (H, W), got {len(ids)} ids "
+                                 f"and shape {shape}")
         for array in (cost, blocks):
             array.setflags(write=False)
         object.__setattr__(self, "cost", cost)
         object.__setattr__(self, "blocks", blocks)
         object.__setattr__(self, "ids", ids)
         object.__setattr__(self, "start", start)
+        object.__setattr__(self, "shape", shape)
 
     @classmethod
     def from_tileset(cls, tileset: Tileset, *, start: int | None = 1,
@@ -212,6 +274,8 @@ class SequencingInstance:
             If no tile has the start label.
         PlanningError
             If the tileset has no tiles.
+        ParameterError
+            If ``tileset`` is not a Tileset.
 
         Examples
         --------
@@ -220,6 +284,7 @@ class SequencingInstance:
         >>> inst.cost.tolist(), inst.start
         ([[0.0, 1.0], [1.0, 0.0]], 0)
         """
+        check_tileset(tileset)
         if len(tileset) == 0:
             raise PlanningError(f"{tileset.name or 'tileset'} has no tiles to sequence")
         index = None if start is None else tileset.index(start)
@@ -242,7 +307,14 @@ class SequencingInstance:
         PlanningError
             If it is not a permutation of 0…n−1 or does not begin at the start waypoint.
         """
-        order = np.asarray(order, dtype=np.int64).reshape(-1)
+        try:
+            array = np.asarray(order)
+            ok = array.size == 0 or np.issubdtype(array.dtype, np.integer)
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
+            raise PlanningError(f"an order must be waypoint indices, got {reprlib.repr(order)}")
+        order = array.astype(np.int64).reshape(-1)
         if len(order) != self.n or not np.array_equal(np.sort(order), np.arange(self.n)):
             raise PlanningError(f"an order must visit each of the {self.n} waypoints exactly once")
         if self.start is not None and order[0] != self.start:
@@ -252,6 +324,28 @@ class SequencingInstance:
     def tile_order(self, order) -> list[int]:
         """Tile labels of an order of waypoint indices."""
         return [self.ids[i] for i in np.asarray(order, dtype=np.int64).tolist()]
+
+
+def check_instance(instance, name: str = "instance") -> SequencingInstance:
+    """``instance`` itself if it is a :class:`SequencingInstance`: the one check of every
+    sequencing entry point.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``name`` and what it got (with how to make an instance).
+
+    Examples
+    --------
+    >>> check_instance("fig13b.txt")
+    Traceback (most recent call last):
+    ...
+    htetro_opt.errors.ParameterError: instance must be a SequencingInstance (e.g. SequencingInstance.from_tileset(load_tileset(path))), got str 'fig13b.txt'
+    """
+    if not isinstance(instance, SequencingInstance):
+        raise ParameterError(f"{name} must be a SequencingInstance (e.g. SequencingInstance.from_tileset("
+                             f"load_tileset(path))), got {type(instance).__name__} {reprlib.repr(instance)}")
+    return instance
 
 
 def __getattr__(name: str):

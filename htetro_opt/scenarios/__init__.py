@@ -6,6 +6,7 @@ from importlib import resources
 from pathlib import Path
 
 from htetro_opt.errors import ScenarioError
+from htetro_opt.scenarios._paths import as_path
 from htetro_opt.scenarios.loader import (
     ContinuousScenario,
     Scenario,
@@ -57,6 +58,7 @@ def list_scenarios() -> list[str]:
 
 
 def _bundled_or_file(name_or_path: str | Path, folder: Path, suffix: str, kind: str, names) -> Path:
+    as_path(name_or_path, kind, expected="a bundled name or a file path")
     bundled = folder / f"{name_or_path}{suffix}"
     if isinstance(name_or_path, str) and "/" not in name_or_path and bundled.is_file():
         return bundled
@@ -80,6 +82,12 @@ def scenario_path(name_or_path: str | Path) -> Path:
 def load_scenario(name_or_path: str | Path) -> Scenario | ContinuousScenario:
     """Load a bundled scenario by name, or a scenario file by path.
 
+    Raises
+    ------
+    ScenarioError
+        If ``name_or_path`` is neither a bundled name nor an existing file (nor a str or path at
+        all), or the file is malformed (see :func:`load_scenario_file`).
+
     Examples
     --------
     >>> scenario = load_scenario("three_slit")
@@ -90,7 +98,7 @@ def load_scenario(name_or_path: str | Path) -> Scenario | ContinuousScenario:
 
 
 def list_tilesets() -> list[str]:
-    """Names of the bundled labelled tilesets (the seed-003 paper's own figures), sorted."""
+    """Names of the bundled labelled tilesets (the figures of Le et al. 2018), sorted."""
     return sorted(p.stem for p in (_data_dir() / "tilesets").glob("*.txt"))
 
 

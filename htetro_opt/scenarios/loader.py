@@ -3,7 +3,7 @@
 A grid scenario::
 
     name = "three_slit"
-    source = "seed 000, Fig. 9d (reconstructed)"
+    source = "Cheng et al. 2020, Fig. 9d (reconstructed)"
     description = "..."            # optional
     cell_size_m = 0.25             # optional, d_grid in metres
     grid = '''
@@ -24,13 +24,14 @@ A grid scenario::
     speed = 1                      # cells per command, optional
     mode = "pingpong"              # or "loop", optional
 
-A continuous scenario (seed 002) has ``width``, ``height``, ``obstacles`` (rectangles
+A continuous scenario (Nazarahari et al. 2019) has ``width``, ``height``, ``obstacles`` (rectangles
 ``[xmin, ymin, xmax, ymax]`` or polygons ``[[x, y], ...]``), ``robot_radius`` and ``[[robots]]`` with
 ``start`` and ``goal`` points.
 """
 
 from __future__ import annotations
 
+import reprlib
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -38,10 +39,11 @@ from typing import Any
 
 import numpy as np
 
-from htetro_opt._validation import check_real
+from htetro_opt._validation import check_int, check_real
 from htetro_opt.errors import ConfigurationError, MapFormatError, ParameterError, ScenarioError, UnknownShapeError
 from htetro_opt.model.robot import Pose, shape_index
-from htetro_opt.model.workspace import MovingObstacle, Workspace
+from htetro_opt.model.workspace import MovingObstacle, Workspace, describe_cells
+from htetro_opt.scenarios._paths import as_path
 from htetro_opt.scenarios.rosmap import load_ros_map
 
 __all__ = ["Scenario", "ContinuousScenario", "load_scenario_file", "parse_scenario", "parse_grid", "format_grid"]
@@ -79,7 +81,7 @@ class Scenario:
 
 @dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
 class ContinuousScenario:
-    """A continuous W × H rectangle with polygon obstacles and point robots (seed 002)."""
+    """A continuous W × H rectangle with polygon obstacles and point robots (Nazarahari et al. 2019)."""
 
     name: str
     source: str
@@ -128,8 +130,20 @@ def parse_grid(text: str, *, where: str = "grid") -> np.ndarray:
 
 
 def format_grid(occupancy: np.ndarray) -> str:
-    """Text rows (top first) of an occupancy grid; the inverse of :func:`parse_grid`."""
-    return "\n".join("".join("#" if v else "." for v in row) for row in np.asarray(occupancy)[::-1])
+    """Text rows (top first) of an occupancy grid; the inverse of :func:`parse_grid`.
+
+    Raises
+    ------
+    ScenarioError
+        If ``occupancy`` is not a non-empty 2-D array of booleans or 0/1.
+
+    Examples
+    --------
+    >>> print(format_grid([[0, 0, 0], [1, 0, 0]]))
+    #..
+    ...
+    """
+    return "\n".join("".join("#" if v else "." for v in row) for row in Workspace(occupancy).occupancy[::-1])
 
 
 def _require(table: dict, key: str, kinds, where: str):
@@ -240,11 +254,12 @@ def _check_pose_on_map(pose: Pose, workspace: Workspace, where: str, t: int | No
     if outside:
         raise ConfigurationError(
             f"{where}: {pose.shape}-shape at ({pose.x}, {pose.y}) heading {pose.heading} "
-            f"has block(s) outside the {workspace.width} x {workspace.height} map at {outside}"
+            f"has block(s) outside the {workspace.width} x {workspace.height} map at {describe_cells(outside)}"
         )
     if hits:
         raise ConfigurationError(
-            f"{where}: {pose.shape}-shape at ({pose.x}, {pose.y}) heading {pose.heading} collides with obstacle cell(s) {hits}"
+            f"{where}: {pose.shape}-shape at ({pose.x}, {pose.y}) heading {pose.heading} collides with obstacles "
+            f"at {describe_cells(hits)}"
         )
 
 
@@ -264,16 +279,17 @@ def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = N
     UnknownShapeError
         If a roadmap configuration names an unknown shape.
     """
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{where}: data must be a table (a dict, as tomllib reads a file), "
+                            f"got {type(data).__name__} {reprlib.repr(data)}")
     if "grid" not in data and "map" not in data and ("width" in data or "robots" in data):
         return _parse_continuous(data, where=where, base=base, default_name=default_name)
     name, source, description = _header(data, _GRID_KEYS, where, default_name)
     if ("grid" in data) == ("map" in data):
         raise ScenarioError(f"{where}: give exactly one of 'grid' (text rows) or 'map' (a ROS map YAML)")
-    try:
-        cell_size = check_real(data.get("cell_size_m"), f"{where}: 'cell_size_m'", minimum=0.0, include_minimum=False,
-                               allow_none=True)
-    except ParameterError as err:  # a file's content: the loader's error
-        raise ScenarioError(str(err)) from err
+    cell_size = None
+    if "cell_size_m" in data:
+        cell_size = _number(data, "cell_size_m", where, minimum=0.0, include_minimum=False)
     if "grid" in data:
         occ = parse_grid(_require(data, "grid", str, where), where=f"{where}: grid")
         cell_size = float(cell_size) if cell_size is not None else 1.0
@@ -293,7 +309,11 @@ def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = N
         cells = _cells(_require(entry, "cells", list, at), f"{at}: cells")
         route = _cells(entry.get("route", [[0, 0]]), f"{at}: route")
         try:
-            obstacle = MovingObstacle(cells, route, speed=entry.get("speed", 1), mode=entry.get("mode", "pingpong"))
+            speed = check_int(entry.get("speed", 1), f"{at}: 'speed' (cells per command)", minimum=1)
+        except ParameterError as err:  # a file's content: the loader's error
+            raise ScenarioError(str(err)) from err
+        try:
+            obstacle = MovingObstacle(cells, route, speed=speed, mode=entry.get("mode", "pingpong"))
         except ScenarioError as err:
             raise ScenarioError(f"{at}: {err}") from err
         _check_route(obstacle, occ, at)
@@ -304,7 +324,10 @@ def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = N
         if not (0 <= x < w and 0 <= y < h):
             raise ScenarioError(f"{where}: hidden obstacle ({x}, {y}) lies outside the {w} x {h} map")
     entries = _array(data, "roadmap", where, tables=True)
-    workspace = Workspace(occ, cell_size, tuple(moving))
+    try:
+        workspace = Workspace(occ, cell_size, tuple(moving))
+    except ScenarioError as err:
+        raise ScenarioError(f"{where}: {err}") from err
     roadmap = []
     for i, entry in enumerate(entries, start=1):
         at = f"{where}: roadmap[{i}]" + (" (start)" if i == 1 else " (goal)" if i == len(entries) else "")
@@ -375,9 +398,10 @@ def load_scenario_file(path: str | Path) -> Scenario | ContinuousScenario:
     Raises
     ------
     ScenarioError
-        If the file cannot be read or is not valid TOML (with the parser's line and column).
+        If ``path`` is not a path, the file cannot be read or is not valid TOML (with the parser's
+        line and column), or a key is missing, unknown or mistyped (naming the file and the key).
     """
-    path = Path(path)
+    path = as_path(path, "path")
     try:
         text = path.read_text(encoding="utf-8-sig")  # a byte-order mark, as some editors write, is fine
     except OSError as err:

@@ -17,7 +17,9 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from htetro_opt.errors import MapFormatError, ScenarioError
+from htetro_opt._validation import check_real
+from htetro_opt.errors import MapFormatError, ParameterError, ScenarioError
+from htetro_opt.scenarios._paths import as_path
 
 __all__ = ["read_pgm", "load_ros_map"]
 
@@ -31,7 +33,7 @@ def read_pgm(path: str | Path) -> tuple[np.ndarray, int]:
     maxval : int
         The maximum pixel value of the header.
     """
-    path = Path(path)
+    path = as_path(path, "path")
     try:
         data = path.read_bytes()
     except OSError as err:
@@ -103,7 +105,11 @@ def load_ros_map(yaml_path: str | Path, *, cell_size: float | None = None) -> tu
     MapFormatError
         If the image is not a valid PGM.
     """
-    yaml_path = Path(yaml_path)
+    yaml_path = as_path(yaml_path, "yaml_path")
+    try:
+        cell_size = check_real(cell_size, "cell_size", minimum=0.0, include_minimum=False, allow_none=True)
+    except ParameterError as err:
+        raise ScenarioError(f"{yaml_path}: {err}") from err
     try:
         meta = yaml.safe_load(yaml_path.read_text(encoding="utf-8"))
     except OSError as err:
@@ -120,15 +126,27 @@ def load_ros_map(yaml_path: str | Path, *, cell_size: float | None = None) -> tu
     for key in ("image", "resolution"):
         if key not in meta:
             raise ScenarioError(f"{yaml_path}: missing key {key!r}")
+    values = {}
+    for key, default, bounds in (("resolution", None, {"minimum": 0.0, "include_minimum": False}),
+                                 ("occupied_thresh", 0.65, {"minimum": 0.0, "maximum": 1.0}),
+                                 ("free_thresh", 0.196, {"minimum": 0.0, "maximum": 1.0})):
+        value = meta.get(key, default)
+        if isinstance(value, str):  # PyYAML reads 5e-2 (no dot) as a string
+            try:
+                value = float(value)
+            except ValueError:
+                pass  # check_real names it
+        try:
+            values[key] = check_real(value, repr(key), **bounds)
+        except ParameterError as err:
+            raise ScenarioError(f"{yaml_path}: {err}") from err
+    resolution, occupied, free = values["resolution"], values["occupied_thresh"], values["free_thresh"]
     try:
-        resolution = float(meta["resolution"])
-        occupied = float(meta.get("occupied_thresh", 0.65))
-        free = float(meta.get("free_thresh", 0.196))
         negate = bool(int(meta.get("negate", 0)))
     except (TypeError, ValueError) as err:
-        raise ScenarioError(f"{yaml_path}: non-numeric resolution or threshold") from err
-    if not (resolution > 0 and 0 <= free <= occupied <= 1):
-        raise ScenarioError(f"{yaml_path}: need resolution > 0 and 0 <= free_thresh <= occupied_thresh <= 1")
+        raise ScenarioError(f"{yaml_path}: 'negate' must be 0 or 1, got {meta.get('negate')!r}") from err
+    if free > occupied:
+        raise ScenarioError(f"{yaml_path}: need free_thresh <= occupied_thresh, got {free:g} > {occupied:g}")
     if meta.get("mode", "trinary") not in ("trinary", "scale"):
         raise ScenarioError(f"{yaml_path}: map mode {meta['mode']!r} is not supported (trinary or scale)")
     image, maxval = read_pgm(yaml_path.parent / str(meta["image"]))

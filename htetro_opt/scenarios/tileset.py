@@ -1,4 +1,4 @@
-"""Labelled tilesets (seed 003, shared/MODEL.md §6): tiles, their block cells a–d, and the text format.
+"""Labelled tilesets (Le et al. 2018, shared/MODEL.md §6): tiles, their block cells a–d, and the text format.
 
 The text lists the grid's rows top first, one whitespace-separated token per cell:
 
@@ -24,21 +24,26 @@ Examples
 from __future__ import annotations
 
 import re
+import reprlib
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from htetro_opt._files import write_text
-from htetro_opt._validation import check_real
-from htetro_opt.errors import ParameterError, ScenarioError, TilesetFormatError
-from htetro_opt.model.robot import Pose
+from htetro_opt._validation import check_int, check_real
+from htetro_opt.errors import OutputError, ParameterError, ScenarioError, TilesetFormatError
+from htetro_opt.model.robot import Pose, as_pose
 from htetro_opt.model.tiles import identify_tile, scan_key, tile_poses
+from htetro_opt.model.workspace import Workspace
+from htetro_opt.scenarios._paths import as_path
 
-__all__ = ["Tileset", "BLOCK_LETTERS", "parse_tileset", "format_tileset", "load_tileset", "save_tileset"]
+__all__ = ["Tileset", "BLOCK_LETTERS", "parse_tileset", "format_tileset", "load_tileset", "save_tileset",
+           "check_tileset"]
 
 BLOCK_LETTERS = "abcd"
-"""Seed 003's block names, in chain order: a, b, c, d = B1, B2, B3, B4 (b is the reference)."""
+"""Le et al. 2018's block names, in chain order: a, b, c, d = B1, B2, B3, B4 (b is the reference)."""
 
 _LABEL = re.compile(r"^([1-9][0-9]*)([abcd])$")
 _OBSTACLE_TOKENS = ("#", "-1")
@@ -69,12 +74,22 @@ class Tileset:
     name: str = ""
 
     def __post_init__(self) -> None:
-        occ = np.array(self.occupancy, dtype=bool)
-        blocks = np.array(self.blocks, dtype=np.int64).reshape(-1, 4, 2)
-        ids = tuple(int(i) for i in self.ids)
         where = self.name or "tileset"
-        if occ.ndim != 2 or 0 in occ.shape:
-            raise TilesetFormatError(f"{where}: occupancy must be a non-empty 2-D array, got shape {occ.shape}")
+        if not isinstance(self.name, str):
+            raise TilesetFormatError(f"a tileset's name must be a string, got {reprlib.repr(self.name)}")
+        try:
+            occ = Workspace(self.occupancy).occupancy.copy()
+        except ScenarioError as err:
+            raise TilesetFormatError(f"{where}: {err}") from err
+        try:
+            blocks = np.asarray(self.blocks)
+            if (blocks.size and not np.issubdtype(blocks.dtype, np.integer)) or blocks.size % 8:
+                raise ValueError
+            blocks = blocks.astype(np.int64).reshape(-1, 4, 2)
+            ids = tuple(check_int(i, "tile id") for i in self.ids)
+        except (TypeError, ValueError) as err:  # ParameterError among them
+            raise TilesetFormatError(f"{where}: blocks must be (n, 4, 2) integer cells and ids n integers, got blocks "
+                                     f"{reprlib.repr(self.blocks)} and ids {reprlib.repr(self.ids)}") from err
         if len(ids) != len(blocks) or len(set(ids)) != len(ids):
             raise TilesetFormatError(f"{where}: need one distinct id per tile, got {len(ids)} ids for {len(blocks)} tiles")
         try:
@@ -105,8 +120,15 @@ class Tileset:
         """The tileset of robot poses: each pose's footprint is a tile, labelled B1–B4 = a–d.
 
         ``ids`` default to 1, 2, … in the order of ``poses``.
+
+        Raises
+        ------
+        ConfigurationError, UnknownShapeError
+            If an item of ``poses`` is not a pose (naming it, ``poses[i]``).
         """
-        poses = list(poses)
+        if isinstance(poses, (str, bytes, Pose)) or not isinstance(poses, Iterable):
+            raise ParameterError(f"poses must be a sequence of poses, got {type(poses).__name__} {reprlib.repr(poses)}")
+        poses = [as_pose(p, f"poses[{i}]") for i, p in enumerate(poses)]
         blocks = np.array([p.cells() for p in poses], dtype=np.int64).reshape(-1, 4, 2)
         ids = tuple(range(1, len(poses) + 1)) if ids is None else ids
         return cls(occupancy, blocks, ids, cell_size, name)
@@ -167,10 +189,10 @@ class Tileset:
             If no tile has that label.
         """
         try:
-            return self.ids.index(int(tile_id))
-        except ValueError as err:
+            return self.ids.index(check_int(tile_id, "tile id"))
+        except ValueError as err:  # ParameterError among them
             raise TilesetFormatError(
-                f"{self.name or 'tileset'} has no tile {tile_id} (tiles {self.ids[0]}…{self.ids[-1]})"
+                f"{self.name or 'tileset'} has no tile {tile_id!r} (tiles {self.ids[0]}…{self.ids[-1]})"
                 if self.ids else f"{self.name or 'tileset'} has no tiles"
             ) from err
 
@@ -243,6 +265,7 @@ def format_tileset(tileset: Tileset) -> str:
     1d 1c
     #  #
     """
+    check_tileset(tileset)
     labels: dict[tuple[int, int], list[str]] = {}
     for tile, cells in zip(tileset.ids, tileset.blocks):
         for letter, (x, y) in zip(BLOCK_LETTERS, cells.tolist()):
@@ -270,7 +293,7 @@ def load_tileset(path: str | Path, *, cell_size: float = 1.0) -> Tileset:
     TilesetFormatError
         If its content is malformed (see :func:`parse_tileset`).
     """
-    path = Path(path)
+    path = as_path(path, "path")
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as err:
@@ -284,6 +307,23 @@ def save_tileset(tileset: Tileset, path: str | Path) -> None:
     Raises
     ------
     OutputError
-        If the file cannot be written.
+        If the file cannot be written (or ``path`` is not a path).
+    ParameterError
+        If ``tileset`` is not a Tileset.
     """
-    write_text(path, format_tileset(tileset) + "\n", what="tileset")
+    check_tileset(tileset)
+    write_text(as_path(path, "path", OutputError), format_tileset(tileset) + "\n", what="tileset")
+
+
+def check_tileset(tileset, name: str = "tileset") -> Tileset:
+    """``tileset`` itself if it is a :class:`Tileset`: the one check of every argument that takes one.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``name`` and what it got.
+    """
+    if not isinstance(tileset, Tileset):
+        raise ParameterError(f"{name} must be a Tileset (e.g. from load_tileset or tile_workspace), "
+                             f"got {type(tileset).__name__} {reprlib.repr(tileset)}")
+    return tileset

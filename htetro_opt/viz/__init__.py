@@ -1,7 +1,15 @@
 """Plotting, kept apart from computing: matplotlib is imported only when a plot is drawn."""
 
-from htetro_opt.viz.plot import SELECTION_STYLES, SHAPE_COLOURS, plot_ga_plan, plot_path, save_figure
+from htetro_opt.viz.plot import (
+    DENSE_CELL_PT,
+    SELECTION_STYLES,
+    SHAPE_COLOURS,
+    figure_format,
+    plot_ga_plan,
+    plot_path,
+    save_figure,
+)
 from htetro_opt.viz.tiles import plot_coverage, plot_tileset
 
-__all__ = ["SELECTION_STYLES", "SHAPE_COLOURS", "plot_ga_plan", "plot_path", "save_figure",
-           "plot_coverage", "plot_tileset"]
+__all__ = ["SELECTION_STYLES", "SHAPE_COLOURS", "DENSE_CELL_PT", "plot_ga_plan", "plot_path", "save_figure",
+           "figure_format", "plot_coverage", "plot_tileset"]

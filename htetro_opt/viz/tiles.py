@@ -5,16 +5,32 @@ matplotlib is imported only inside the functions; nothing here computes a plan o
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from htetro_opt.errors import HtetroError, ParameterError
 from htetro_opt.scenarios.tileset import BLOCK_LETTERS, Tileset
-from htetro_opt.viz.plot import SHAPE_COLOURS, _pyplot
+from htetro_opt.viz.plot import (
+    DENSE_CELL_PT,
+    SHAPE_COLOURS,
+    _cell_points,
+    _legend,
+    _mixed_image,
+    _outline_segments,
+    _pyplot,
+    _shape_counts,
+    _squares,
+)
 
 __all__ = ["plot_tileset", "plot_coverage"]
 
 _OBSTACLE_COLOUR = "#333333"
 _UNKNOWN_COLOUR = "#bbbbbb"
+_ORDER_COLOUR = "#c0392b"
+_CHAR_WIDTH = 0.6  # a digit's width in DejaVu Sans, as a share of the font size
+_MIN_FONT = 5.0  # pt: smaller labels are noise, not information
+_MOST_VISIT_NUMBERS = 40
 
 
 def _figure(ax, width: int, height: int, extra: float = 1.6):
@@ -23,7 +39,7 @@ def _figure(ax, width: int, height: int, extra: float = 1.6):
         return ax.figure, ax
     side = min(9.0, max(4.0, 0.55 * max(width, height)))
     aspect = height / width
-    fig, ax = plt.subplots(figsize=(side + extra, max(2.5, side * aspect) + 0.7), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(side + extra, max(2.5, side * aspect) + 0.7), layout="compressed")
     return fig, ax
 
 
@@ -42,13 +58,38 @@ def _frame(ax, width: int, height: int, title: str) -> None:
         ax.set_title(title, fontsize=10)
 
 
+def _label_font(cell_pt: float, chars: int) -> float:
+    """The font size (pt) at which ``chars`` characters fill 90 % of a cell's width, at most 9."""
+    return min(9.0, 0.9 * cell_pt / (_CHAR_WIDTH * max(chars, 1)))
+
+
+def _visit_step(n: int, most: int = _MOST_VISIT_NUMBERS) -> int:
+    """The smallest of 1, 2, 5, 10, 20, 50, … that numbers at most ``most`` of ``n`` visits."""
+    step, scale = 1, 1
+    while n / step > most:
+        for factor in (2, 5, 10):
+            step = factor * scale
+            if n / step <= most:
+                break
+        scale *= 10
+    return step
+
+
 def plot_tileset(tileset: Tileset, order=None, *, title: str = "", ax=None):
     """Draw a labelled tileset and, optionally, a visiting order (seed 003's Figs. 13–14).
 
-    Tiles are filled with their morphology's colour (:data:`SHAPE_COLOURS`), each cell shows its
-    labels (``12b``), tile borders are drawn thick and obstacles dark. With an order, arrows join
-    consecutive tiles' block-b cells and each block b carries its visit number (the start circled in
-    green).
+    Tiles are filled with their morphology's colour (:data:`SHAPE_COLOURS`; one image, darker where
+    tiles overlap), tile borders are drawn thick and obstacles dark. With an order, the path joins
+    consecutive tiles' block-b cells (B2, the robot's reference) and carries visit numbers (the start
+    in green).
+
+    How much is written depends on how large a cell is on the figure, so that a large tileset stays
+    readable: each cell carries its labels (``12b``: block b of tile 12) only when the longest label
+    fits in a cell at 5 pt or more (on a 9-inch figure, up to about 40 × 40 cells); each visit gets
+    a circled number and an arrow to the next one when its number fits likewise, otherwise the order
+    is a line through the block-b cells with a number at visits 1, k, 2k, … and the last, k being the
+    smallest of 1, 2, 5, 10, 20, 50, … that writes at most 40 numbers. The 64 × 64 tiling (1004
+    tiles) thus gets tile colours, borders, the path and 22 numbers, and draws and saves in about half a second.
 
     Parameters
     ----------
@@ -56,6 +97,7 @@ def plot_tileset(tileset: Tileset, order=None, *, title: str = "", ax=None):
     order : sequence of int, optional
         Tile labels (ids, not indices) in visiting order.
     title : str, keyword-only
+        Drawn as given; by default the tileset's name without its folder.
     ax : matplotlib Axes, optional, keyword-only
 
     Returns
@@ -71,8 +113,8 @@ def plot_tileset(tileset: Tileset, order=None, *, title: str = "", ax=None):
     --------
     >>> from htetro_opt.scenarios import parse_tileset
     >>> fig = plot_tileset(parse_tileset("1a 1b 1c 1d\\n2a 2b 2c 2d"), [1, 2])
-    >>> len(fig.axes)
-    1
+    >>> sorted(t.get_text() for t in fig.axes[0].texts)
+    ['1', '1a', '1b', '1c', '1d', '2', '2a', '2b', '2c', '2d']
     >>> import matplotlib.pyplot as plt; plt.close(fig)
     """
     if not isinstance(tileset, Tileset):
@@ -83,72 +125,100 @@ def plot_tileset(tileset: Tileset, order=None, *, title: str = "", ax=None):
             visits = [tileset.index(t) for t in order]
         except (HtetroError, TypeError, ValueError) as err:
             raise ParameterError(f"order: {err}") from err
-    from matplotlib.collections import LineCollection, PatchCollection
-    from matplotlib.colors import to_rgba
-    from matplotlib.patches import Patch, Rectangle
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import ListedColormap
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
 
     w, h = tileset.width, tileset.height
-    fig, ax = _figure(ax, w, h, extra=2.1)
-    font = max(4.0, min(9.0, 70.0 / max(w, h)))
-    squares, colours = [], []
-    for y, x in zip(*np.nonzero(tileset.occupancy)):
-        squares.append(Rectangle((x - 0.5, y - 0.5), 1, 1))
-        colours.append(to_rgba(_OBSTACLE_COLOUR))
-    labels: dict[tuple[int, int], list[str]] = {}
+    fig, ax = _figure(ax, w, h, extra=3.2)
+    cell_pt = _cell_points(ax, w, h)
     shapes = tileset.shapes
-    used = []
-    for i, (tile, cells) in enumerate(zip(tileset.ids, tileset.blocks)):
-        colour = to_rgba(SHAPE_COLOURS.get(shapes[i], _UNKNOWN_COLOUR), 0.35)
-        if shapes[i] not in used:
-            used.append(shapes[i])
-        for letter, (x, y) in zip(BLOCK_LETTERS, cells.tolist()):
-            squares.append(Rectangle((x - 0.5, y - 0.5), 1, 1))
-            colours.append(colour)
-            labels.setdefault((x, y), []).append(f"{tile}{letter}")
-    if squares:
-        ax.add_collection(PatchCollection(squares, facecolors=colours, linewidths=0))
-    # thin grid, then thick borders wherever a tile's cell meets a cell of another tile (or none)
+    used = list(dict.fromkeys(shapes))
+    colours = [SHAPE_COLOURS.get(s, _UNKNOWN_COLOUR) for s in used]
+    if len(tileset):
+        counts = _shape_counts(tileset.blocks, np.array([used.index(s) for s in shapes]), len(used), h, w)
+        ax.imshow(_mixed_image(counts, colours, 0.35, cap=1.0), origin="lower", interpolation="nearest",
+                  extent=(-0.5, w - 0.5, -0.5, h - 0.5), zorder=1, gid="tiles")
+    obstacles = np.ma.masked_where(~tileset.occupancy, tileset.occupancy.astype(float))
+    ax.imshow(obstacles, cmap=ListedColormap([_OBSTACLE_COLOUR]), origin="lower", interpolation="nearest",
+              extent=(-0.5, w - 0.5, -0.5, h - 0.5), zorder=1, gid="obstacles")
     thin = [[(x - 0.5, -0.5), (x - 0.5, h - 0.5)] for x in range(w + 1)]
     thin += [[(-0.5, y - 0.5), (w - 0.5, y - 0.5)] for y in range(h + 1)]
-    ax.add_collection(LineCollection(thin, colors="#cccccc", linewidths=0.5))
-    thick = []
-    for i, cells in enumerate(tileset.blocks):
-        mine = {tuple(c) for c in cells.tolist()}
-        for x, y in mine:
-            for dx, dy in ((1, 0), (-1, 0), (0, 1), (0, -1)):
-                if (x + dx, y + dy) in mine:
-                    continue
-                if dx:
-                    ex = x + dx / 2
-                    thick.append([(ex, y - 0.5), (ex, y + 0.5)])
-                else:
-                    ey = y + dy / 2
-                    thick.append([(x - 0.5, ey), (x + 0.5, ey)])
-    if thick:
-        ax.add_collection(LineCollection(thick, colors="black", linewidths=1.8))
-    for (x, y), names in labels.items():
-        text = "/".join(names)
-        ax.text(x, y + (0.22 if visits is not None else 0.0), text, ha="center", va="center",
-                fontsize=font * (0.8 if len(names) > 1 else 1.0), color="#222222", in_layout=False)
-    if visits:
-        refs = tileset.blocks[visits, 1].astype(float)
-        for k in range(len(refs) - 1):
-            ax.annotate("", xy=refs[k + 1], xytext=refs[k], annotation_clip=False, in_layout=False,
-                        arrowprops={"arrowstyle": "-|>", "color": "#c0392b", "linewidth": 1.3,
-                                    "shrinkA": 5, "shrinkB": 5, "mutation_scale": 9})
-        for k, (x, y) in enumerate(refs):
-            edge = "green" if k == 0 else "#c0392b"
-            ax.text(x, y - 0.18, str(k + 1), ha="center", va="center", fontsize=font * 0.9, color="white", in_layout=False,
-                    fontweight="bold", bbox={"boxstyle": "circle,pad=0.15", "facecolor": edge, "edgecolor": "none"})
-    handles = [Patch(facecolor=SHAPE_COLOURS.get(s, _UNKNOWN_COLOUR), alpha=0.5, label=f"{s}-shape") for s in used]
+    ax.add_collection(LineCollection(thin, colors="#cccccc", linewidths=0.5, zorder=1.5))
+    border = 1.8 if cell_pt >= DENSE_CELL_PT else 0.9
+    if len(tileset):
+        segments, _ = _outline_segments(tileset.blocks)
+        ax.add_collection(LineCollection(segments, colors="black", linewidths=border, zorder=2))
+
+    handles = [Patch(facecolor=c, alpha=0.5, label=f"{s}-shape tile") for s, c in zip(used, colours)]
+    handles.append(Line2D([], [], color="black", linewidth=border, label="tile border"))
     if tileset.occupancy.any():
         handles.append(Patch(facecolor=_OBSTACLE_COLOUR, label="obstacle"))
+    longest = max((len(str(i)) + 1 for i in tileset.ids), default=2)
+    font = _label_font(cell_pt, longest)
+    labelled = len(tileset) > 0 and font >= _MIN_FONT
+    if labelled:
+        _draw_cell_labels(ax, tileset, font, shifted=visits is not None)
+        handles.append(Patch(facecolor="none", edgecolor="none",
+                             label=f"{tileset.ids[0]}b: block b of tile {tileset.ids[0]}"))
     if visits:
-        handles.append(Patch(facecolor="green", label="start (visit 1)"))
-    if handles:
-        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
-    _frame(ax, w, h, title or tileset.name)
+        handles += _draw_order(ax, tileset.blocks[visits, 1], cell_pt)
+    if labelled or visits:
+        handles.append(Patch(facecolor="none", edgecolor="none", label="a–d: blocks B1–B4 (b = B2, the reference)"))
+    _legend(ax, handles)
+    _frame(ax, w, h, title or Path(tileset.name).name)
     return fig
+
+
+def _draw_cell_labels(ax, tileset: Tileset, font: float, *, shifted: bool) -> None:
+    labels: dict[tuple[int, int], list[str]] = {}
+    for tile, cells in zip(tileset.ids, tileset.blocks.tolist()):
+        for letter, (x, y) in zip(BLOCK_LETTERS, cells):
+            labels.setdefault((x, y), []).append(f"{tile}{letter}")
+    for (x, y), names in labels.items():
+        ax.text(x, y + (0.22 if shifted else 0.0), "/".join(names), ha="center", va="center",
+                fontsize=font * (0.8 if len(names) > 1 else 1.0), color="#222222", in_layout=False, zorder=3)
+
+
+def _draw_order(ax, refs: np.ndarray, cell_pt: float) -> list:
+    """The visiting order through block-b cells ``refs`` (n, 2): arrows and every number when they
+    fit in a cell, else a line and every k-th number. Returns the legend handles."""
+    from matplotlib.lines import Line2D
+
+    refs = refs.astype(float)
+    n = len(refs)
+    font = _label_font(cell_pt, len(str(n)) + 1)
+    every = font >= _MIN_FONT
+    step = 1 if every else _visit_step(n)
+    if every:
+        tail, head = refs[:-1], refs[1:]
+        gap = head - tail
+        length = np.hypot(gap[:, 0], gap[:, 1])
+        keep = length > 0
+        unit = gap[keep] / length[keep, None]
+        ax.quiver(tail[keep, 0] + 0.3 * unit[:, 0], tail[keep, 1] + 0.3 * unit[:, 1],
+                  gap[keep, 0] - 0.6 * unit[:, 0], gap[keep, 1] - 0.6 * unit[:, 1], angles="xy",
+                  scale_units="xy", scale=1, color=_ORDER_COLOUR, width=0.004, headwidth=4, headlength=5,
+                  headaxislength=4.5, zorder=4)
+        numbered = np.arange(n)
+        label = "visiting order, block b to block b"
+    else:
+        ax.plot(refs[:, 0], refs[:, 1], color=_ORDER_COLOUR, linewidth=0.9, marker=".", markersize=2, zorder=4)
+        numbered = np.unique(np.r_[0, np.arange(step - 1, n, step), n - 1])
+        font = max(_MIN_FONT, min(8.0, font * 1.6))
+        label = "visiting order, block b to block b (dots)"
+    for k in numbered.tolist():
+        x, y = refs[k]
+        ax.text(x, y - (0.18 if every else 0.0), str(k + 1), ha="center", va="center", fontsize=font * 0.9,
+                color="white", fontweight="bold", in_layout=False, zorder=5,
+                bbox={"boxstyle": "circle,pad=0.15", "facecolor": "green" if k == 0 else _ORDER_COLOUR,
+                      "edgecolor": "none"})
+    handles = [Line2D([], [], color=_ORDER_COLOUR, linewidth=1.3, marker=">" if every else ".", label=label),
+               Line2D([], [], linestyle="none", marker="o", markersize=8, color=_ORDER_COLOUR,
+                      label="visit number" if every else f"visit number (1, {step}, {2 * step}, …, {n})")]
+    handles.append(Line2D([], [], linestyle="none", marker="o", markersize=8, color="green", label="start (visit 1)"))
+    return handles
 
 
 def plot_coverage(result, *, title: str = "", ax=None):
@@ -157,7 +227,7 @@ def plot_coverage(result, *, title: str = "", ax=None):
     Parameters
     ----------
     result : CoverageResult
-        From :func:`~htetro_opt.studies.coverage.simulate_coverage`.
+        From :func:`~htetro_opt.model.coverage.simulate_coverage`.
     title : str, keyword-only
         Above the map; a line with the average grid time and the distance is added below it.
     ax : matplotlib Axes, optional, keyword-only
@@ -170,7 +240,7 @@ def plot_coverage(result, *, title: str = "", ax=None):
     Examples
     --------
     >>> from htetro_opt.scenarios import parse_tileset
-    >>> from htetro_opt.studies.coverage import simulate_coverage
+    >>> from htetro_opt.model.coverage import simulate_coverage
     >>> fig = plot_coverage(simulate_coverage(parse_tileset("1a 1b 1c 1d\\n2a 2b 2c 2d"), [0, 1]))
     >>> len(fig.axes)  # the map and its colour bar
     2
@@ -180,7 +250,8 @@ def plot_coverage(result, *, title: str = "", ax=None):
         if not hasattr(result, attribute):
             raise ParameterError(f"result must be a CoverageResult, got {type(result).__name__}")
     plt = _pyplot()
-    from matplotlib.patches import Rectangle
+    from matplotlib.collections import PolyCollection
+    from matplotlib.patches import Patch
 
     h, w = result.cell_time.shape
     fig, ax = _figure(ax, w, h, extra=1.2)
@@ -190,9 +261,15 @@ def plot_coverage(result, *, title: str = "", ax=None):
                       extent=(-0.5, w - 0.5, -0.5, h - 0.5))
     bar = fig.colorbar(image, ax=ax, shrink=0.85)
     bar.set_label("coverage time, normalised (0–255)", fontsize=8)
-    for y, x in zip(*np.nonzero(~result.free)):
-        ax.add_patch(Rectangle((x - 0.5, y - 0.5), 1, 1, facecolor=_OBSTACLE_COLOUR, alpha=0.55,
-                               edgecolor="black", hatch="xx", linewidth=0.5))
+    blocked = np.argwhere(~result.free)[:, ::-1]
+    handles = [Patch(facecolor="white", edgecolor="#888888", label="never covered")]
+    if len(blocked):
+        ax.add_collection(PolyCollection(_squares(blocked), facecolors=_OBSTACLE_COLOUR, alpha=0.55,
+                                         edgecolors="black", hatch="xx", linewidths=0.5))
+        handles.append(Patch(facecolor=_OBSTACLE_COLOUR, alpha=0.55, edgecolor="black", hatch="xx",
+                             label="not free (obstacle)"))
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncols=len(handles), fontsize=8,
+              frameon=False)
     if w <= 64 and h <= 64:
         ax.set_xticks(np.arange(-0.5, w, 1), minor=True)
         ax.set_yticks(np.arange(-0.5, h, 1), minor=True)

@@ -94,6 +94,49 @@ def test_unknown_shape_and_bad_poses_raise_typed_errors():
         Pose.of(0.5, 0, "O", 0)
 
 
+@pytest.mark.parametrize("make", [Pose, Pose.of], ids=["Pose", "Pose.of"])
+@pytest.mark.parametrize("fields,error,words", [
+    ((1, 2, "Q", 0), UnknownShapeError, "unknown shape 'Q'"),
+    ((1, 2, None, 0), UnknownShapeError, "unknown shape None"),
+    ((1, 2, "O", 4), ConfigurationError, "heading must be 0, 1, 2 or 3 (quarter turns), got 4"),
+    ((1, 2, "O", -1), ConfigurationError, "got -1"),
+    ((1, 2, "O", 1.0), ConfigurationError, "pose heading must be an integer, got 1.0"),
+    ((1.5, 2, "O", 0), ConfigurationError, "pose x must be an integer, got 1.5"),
+    (("1", 2, "O", 0), ConfigurationError, "pose x must be an integer, got '1'"),
+    ((1, True, "O", 0), ConfigurationError, "pose y must be an integer, got True"),
+])
+def test_every_way_of_making_a_pose_validates_it(make, fields, error, words):
+    with pytest.raises(error) as info:
+        make(*fields)
+    assert words in str(info.value)
+
+
+def test_a_made_pose_is_canonical_and_survives_copies():
+    pose = Pose(np.int64(3), np.int32(4), np.str_("L"), np.int8(1))
+    assert pose == (3, 4, "L", 1) and all(type(v) is t for v, t in zip(pose, (int, int, str, int)))
+    assert Pose(3, 4, "O") == Pose.of(3, 4, "O") == Pose(3, 4, "O", 0)
+    assert pose._replace(heading=2) == Pose(3, 4, "L", 2)
+    with pytest.raises(ConfigurationError, match="got 7"):
+        pose._replace(heading=7)
+    with pytest.raises(UnknownShapeError):
+        Pose._make((0, 0, "Q", 0))
+    import copy
+    import pickle
+
+    for twin in (pickle.loads(pickle.dumps(pose)), copy.deepcopy(pose), copy.copy(pose)):
+        assert twin == pose and type(twin) is Pose
+    assert repr(pose) == "Pose(x=3, y=4, shape='L', heading=1)"
+
+
+def test_the_unknown_shape_error_names_the_intermediate_states():
+    with pytest.raises(UnknownShapeError) as info:
+        shape_index("X")
+    message = str(info.value)
+    assert "I, O, L, J, Z, S, T" in message and "intermediate state such as h112" in message
+    assert "Cheng et al. 2019" in message and "seed" not in message
+    assert Pose(0, 0, "h112", 0).shape == "h112"  # the intermediates themselves are poses
+
+
 @pytest.mark.parametrize("q,expected", [
     ((0, 0, 0, 0, 0, 0), ("I", 0)),  # seed 004's vertical I
     ((0, 0, 0, 0, -math.pi, -math.pi), ("O", 0)),  # seed 004's O

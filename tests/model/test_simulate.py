@@ -1,11 +1,17 @@
 """The vectorised simulator against a plain per-command reference, and its invariants."""
 
+import os
+import re
+import sys
+import time
+import tracemalloc
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from htetro_opt.errors import ConfigurationError, UnknownCommandError
+from htetro_opt.errors import ConfigurationError, PlanningError, UnknownCommandError
 from htetro_opt.model import (
     COMMANDS,
     STATE_NAMES,
@@ -135,6 +141,78 @@ def test_errors():
         sim.run([parse_commands("x+y+")], Pose(1, 1, "O", 0))  # diagonals not enabled
     with pytest.raises(UnknownCommandError, match="'jump' at position 2"):
         parse_commands("x+, jump")
+
+
+def test_a_pose_colliding_with_many_cells_says_how_many_and_shows_five():
+    sim = Simulator(Workspace(np.ones((12, 12), dtype=bool)), clearance=3.0)
+    with pytest.raises(ConfigurationError) as info:
+        sim.check_pose(Pose(5, 5, "O", 0), what="start")
+    message = str(info.value)
+    n = len(sim.pose_conflicts(sim.encode(Pose(5, 5, "O", 0))))
+    assert n > 40 and f"{n} cells" in message and f"and {n - 5} more" in message
+    assert message.count("), (") == 4 and len(message) < 200
+
+
+def test_an_intermediate_state_without_block_commands_names_the_paper_and_the_commands():
+    sim = Simulator(Workspace(np.zeros((6, 6), dtype=bool)))
+    with pytest.raises(ConfigurationError) as info:
+        sim.run([[0]], Pose(2, 2, "h112", 0))
+    message = str(info.value)
+    assert "Cheng et al. 2019's block commands" in message and "3r" in message and "seed" not in message
+
+
+# --- memory budget ---------------------------------------------------------------------------------
+
+SIMULATE = sys.modules["htetro_opt.model.simulate"]  # the module (htetro_opt.model.simulate is the function)
+
+
+def test_a_huge_map_is_refused_at_once_naming_the_memory(monkeypatch):
+    monkeypatch.setattr(Simulator, "_transition_table", lambda self: pytest.fail("allocated before the check"))
+    huge = Workspace(np.zeros((5000, 5000), dtype=bool))
+    began = time.perf_counter()
+    with pytest.raises(PlanningError) as info:
+        Simulator(huge)
+    assert time.perf_counter() - began < 2.0
+    message = str(info.value)
+    assert "5000 x 5000 map" in message and "GiB of memory, more than the budget of" in message
+    assert re.search(r"fit a map of at most [\d,]+ cells \(e\.g\. \d+ x \d+\)", message), message
+
+
+def test_the_budget_is_the_constant_or_half_the_physical_memory():
+    budget = SIMULATE.memory_budget()
+    assert 0 < budget <= SIMULATE.MEMORY_BUDGET
+    if hasattr(os, "sysconf") and "SC_PHYS_PAGES" in os.sysconf_names:
+        assert budget <= os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") // 2
+
+
+@pytest.mark.parametrize("commands", [None, ["x+", "x-", "y+", "y-", "3l", "3r"]], ids=["default", "blocks"])
+def test_the_map_the_message_says_fits_does_fit_and_one_cell_more_does_not(monkeypatch, commands):
+    monkeypatch.setattr(SIMULATE, "MEMORY_BUDGET", 2 * 2**20)  # 2 MiB
+    with pytest.raises(PlanningError) as info:
+        Simulator(Workspace(np.zeros((40, 40), dtype=bool)), commands=commands)
+    fits = int(re.search(r"at most ([\d,]+) cells", str(info.value))[1].replace(",", ""))
+    assert 100 < fits < 1600 and "2.0 MiB" in str(info.value)
+    Simulator(Workspace(np.zeros((1, fits), dtype=bool)), commands=commands)
+    with pytest.raises(PlanningError):
+        Simulator(Workspace(np.zeros((1, fits + 1), dtype=bool)), commands=commands)
+
+
+@pytest.mark.parametrize("commands", [None, ["x+", "x-", "y+", "y-", "3l", "3r"]], ids=["default", "blocks"])
+def test_the_estimate_bounds_the_memory_compiling_and_running_takes(commands):
+    """tracemalloc's peak (numpy reports its arrays to it) against the bytes the budget check counts,
+    with the repair's table of valid commands (the most a run adds)."""
+    ws = Workspace(np.zeros((60, 60), dtype=bool))
+    Simulator(Workspace(np.zeros((8, 8), dtype=bool)), commands=commands)  # sweep tables cached, imports done
+    tracemalloc.start()
+    try:
+        sim = Simulator(ws, commands=commands)
+        run = sim.run([parse_commands("x-,x-,x-,x-")], Pose(2, 2, "O", 0), repair=np.random.default_rng(0))
+        assert run.valid[0] and run.sequence(0).tolist() != parse_commands("x-,x-,x-,x-").tolist()  # repaired
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    estimate = SIMULATE.compile_bytes(sim.n_poses, sim.n_commands)
+    assert peak <= estimate <= 1.4 * peak
 
 
 # --- property tests ----------------------------------------------------------------------------

@@ -6,7 +6,7 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from htetro_opt.errors import ConfigurationError, HtetroError, ParameterError
+from htetro_opt.errors import ConfigurationError, HtetroError, ParameterError, PlanningError
 from htetro_opt.model import (
     SEED000_COMMANDS,
     STATE_NAMES,
@@ -372,3 +372,24 @@ def test_moving_obstacles_make_the_start_time_matter():
     p0 = CommandPathProblem(ws, start, goal, max_length=20, t0=1)
     p1 = CommandPathProblem(ws, start, goal, max_length=20, t0=1 + ws.period)
     assert np.array_equal(p0.evaluate(as_column([seq])), p1.evaluate(as_column([seq])))
+
+
+def test_the_pose_tables_do_not_depend_on_the_slices_they_are_computed_in(monkeypatch):
+    from htetro_opt.problems import command_path  # its module constant is patched
+
+    sim = Simulator(load_scenario("three_slit").workspace.without_moving())
+    start, goal = Pose(3, 11, "O", 0), Pose(20, 11, "O", 0)
+    whole = CommandPathProblem(sim, start, goal)
+    monkeypatch.setattr(command_path, "_POSES_PER_SLICE", 1000)  # 16 slices, the last one short
+    sliced = CommandPathProblem(sim, start, goal)
+    assert np.array_equal(whole._pose_reachability, sliced._pose_reachability)
+    assert np.array_equal(whole._pose_danger, sliced._pose_danger)
+
+
+def test_pose_tables_beyond_the_memory_budget_are_refused(monkeypatch):
+    import sys
+
+    sim = Simulator(Workspace(bordered()))
+    monkeypatch.setattr(sys.modules["htetro_opt.model.simulate"], "MEMORY_BUDGET", 2**16)
+    with pytest.raises(PlanningError, match=r"the path problem's pose tables .* 12 x 12 map \(28 poses a cell\)"):
+        CommandPathProblem(sim, Pose(3, 3, "O", 0), Pose(7, 6, "O", 0))

@@ -114,6 +114,25 @@ def test_instance_refuses_a_start_that_is_no_waypoint_index(start):
     assert SequencingInstance(np.zeros((3, 3)), np.zeros((3, 4, 2)), np.int64(2)).start == 2
 
 
+@pytest.mark.parametrize("options,words", [
+    ({"blocks": np.zeros((2, 4, 2))}, "blocks must hold the cells of the 3 waypoints"),
+    ({"blocks": np.zeros((3, 4, 2)), "ids": (1, 2)}, "need one tile id per waypoint (3)"),
+    ({"blocks": np.zeros((3, 4, 2)), "shape": (4,)}, "grid shape (H, W)"),
+    ({"blocks": np.zeros((3, 4, 2)), "ids": ("a", "b", "c")}, "tile id must be an integer, got 'a'"),
+])
+def test_instance_refuses_parts_that_do_not_match_its_cost_matrix(options, words):
+    with pytest.raises(ParameterError) as info:
+        SequencingInstance(np.zeros((3, 3)), **options)
+    assert words in str(info.value)
+
+
+@pytest.mark.parametrize("order", ["abc", [0.0, 1.0, 2.0], None, [[0, 1], [2]]])
+def test_an_order_that_is_not_indices_is_a_planning_error(order):
+    inst = SequencingInstance(np.zeros((3, 3)), np.zeros((3, 4, 2)), 0)
+    with pytest.raises(PlanningError, match="an order must be waypoint indices"):
+        inst.check_order(order)
+
+
 def walk(points, order):
     """Length of the walk through the points in this order (by hand: every block sits on the point)."""
     return sum(math.dist(points[a], points[b]) for a, b in itertools.pairwise(order))

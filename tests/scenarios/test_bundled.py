@@ -1,5 +1,7 @@
 """The bundled scenario library reconstructs the papers' environments with their stated features."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -31,7 +33,17 @@ def test_size_and_source(scenarios, name):
     sc = scenarios[name]
     assert isinstance(sc, Scenario) and sc.name == name
     assert (sc.workspace.width, sc.workspace.height) == SIZES[name]
-    assert "seed 00" in sc.source and "Fig" in sc.source
+    assert PAPER.match(sc.source) and "Fig" in sc.source, sc.source
+
+
+PAPER = re.compile(r"^(Cheng|Do|Le|Nazarahari) et al\., [A-Za-z ]+ (2018|2019|2020|2021), ")
+"""A bundled source names its paper by authors, venue and year: "Cheng et al., IEEE Access 2020, Fig. 9d"."""
+
+
+def test_no_bundled_text_names_a_paper_by_its_seed_number(scenarios):
+    for name, sc in scenarios.items():
+        for text in (sc.source, sc.description):
+            assert not re.search(r"seed[ -]?00\d", text, re.I), (name, text)
 
 
 @pytest.mark.parametrize("name", SEED_000)

@@ -524,6 +524,45 @@ def test_bad_cell_size(value):
         parse_scenario(grid_data(cell_size_m=value))
 
 
+@pytest.mark.parametrize("key,value,words", [
+    ("cell_size_m", "inf", "'cell_size_m' must be a finite number > 0, got inf"),
+    ("cell_size_m", "nan", "'cell_size_m' must be a finite number > 0, got nan"),
+    ("cell_size_m", "-inf", "'cell_size_m' must be a finite number > 0, got -inf"),
+])
+def test_a_non_finite_number_in_a_file_names_the_file_and_the_key(tmp_path, key, value, words):
+    path = write(tmp_path / "odd.toml", grid_toml(extra=f"{key} = {value}", roadmap=START_GOAL))
+    with pytest.raises(ScenarioError) as info:
+        load_scenario_file(path)
+    message = str(info.value)
+    assert message.startswith("odd.toml: ") and words in message and "None" not in message
+
+
+@pytest.mark.parametrize("speed,words", [("inf", "got inf"), ("1.5", "got 1.5"), ("0", "got 0")])
+def test_a_bad_moving_obstacle_speed_names_the_key(tmp_path, speed, words):
+    moving = f"[[moving]]\ncells = [[6, 6]]\nroute = [[0, 0], [0, -1]]\nspeed = {speed}\n"
+    path = write(tmp_path / "fast.toml", grid_toml(roadmap=START_GOAL + moving))
+    with pytest.raises(ScenarioError) as info:
+        load_scenario_file(path)
+    message = str(info.value)
+    assert message.startswith("fast.toml: moving[1]: 'speed'") and words in message
+
+
+def test_a_ros_map_with_an_infinite_resolution_names_the_yaml_and_the_key(tmp_path):
+    write_map(tmp_path, PIXELS, resolution=".inf")
+    (tmp_path / "s.toml").write_text('name = "s"\nmap = "m.yaml"\n')
+    with pytest.raises(ScenarioError) as info:
+        load_scenario_file(tmp_path / "s.toml")
+    message = str(info.value)
+    assert "m.yaml" in message and "'resolution' must be a finite number > 0, got inf" in message
+
+
+def test_a_start_on_obstacles_says_how_many_cells_collide():
+    data = grid_data(grid="\n".join(["#" * 8] * 8), roadmap=[{"x": 3, "y": 3, "shape": "I"}])
+    with pytest.raises(ConfigurationError) as info:
+        parse_scenario(data, where="walls.toml")
+    assert "collides with obstacles at 4 cells (3, 2), (3, 3), (3, 4), (3, 5)" in str(info.value)
+
+
 # --------------------------------------------------------------------------------------------------
 # ROS map_server maps
 
@@ -653,7 +692,10 @@ def test_bad_pgm_raises_map_format_error(tmp_path, data, words):
 @pytest.mark.parametrize("text,words", [
     ("resolution: 0.05\n", "missing key 'image'"),
     ("image: m.pgm\n", "missing key 'resolution'"),
-    ("image: m.pgm\nresolution: fine\n", "non-numeric"),
+    ("image: m.pgm\nresolution: fine\n", "'resolution' must be a finite number > 0, got 'fine'"),
+    ("image: m.pgm\nresolution: .inf\n", "'resolution' must be a finite number > 0, got inf"),
+    ("image: m.pgm\nresolution: 0.05\noccupied_thresh: .nan\n", "'occupied_thresh' must be a finite number"),
+    ("image: m.pgm\nresolution: 0.05\nnegate: maybe\n", "'negate' must be 0 or 1"),
     ("image: m.pgm\nresolution: 0.05\nfree_thresh: 0.9\noccupied_thresh: 0.2\n", "free_thresh"),
     ("image: m.pgm\nresolution: 0.05\nmode: raw\n", "'raw'"),
     ("- a list\n", "mapping"),

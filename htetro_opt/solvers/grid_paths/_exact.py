@@ -12,8 +12,14 @@ Two algorithms give the same optimum: ``"dijkstra"`` (scipy.sparse.csgraph over 
 fastest here) and ``"astar"`` (a heapq A* that expands only what it needs, with the admissible
 heuristic "grid distance of B2's cell to the goal × the cheapest translation time per cell"). When
 moving obstacles have a long common period the whole time-expanded graph would not fit in memory
-(more than :data:`MAX_EXPANDED_NODES` nodes): "dijkstra" then hands over to A*, and the plan's
-``method`` says so. A leg that is unreachable even without the moving obstacles is reported at once.
+(more than :data:`MAX_EXPANDED_NODES` nodes, or more than the memory budget): "dijkstra" then hands
+over to A*, and the plan's ``method`` says so. A leg that is unreachable even without the moving
+obstacles is reported at once.
+
+Before anything is compiled, the memory the simulator's tables and the search would need is
+estimated; a map that would not fit the budget (:func:`~htetro_opt.model.simulate.memory_budget`)
+is refused with a :class:`~htetro_opt.errors.PlanningError` that says how much it would need and
+what fits.
 """
 
 from __future__ import annotations
@@ -31,15 +37,85 @@ from htetro_opt._validation import check_int
 from htetro_opt.errors import ParameterError, PlanningError
 from htetro_opt.model.commands import COMMANDS, Timing
 from htetro_opt.model.robot import Pose
-from htetro_opt.model.simulate import Simulator
+from htetro_opt.model.simulate import (
+    Simulator,
+    cells_within,
+    check_memory,
+    compile_bytes,
+    map_text,
+    memory_budget,
+    size_text,
+    table_shape,
+)
 from htetro_opt.model.workspace import Workspace, grid_distance
-from htetro_opt.solvers.grid_paths._result import Plan, finish_plan, prepare
+from htetro_opt.solvers.grid_paths._result import Plan, check_map, check_roadmap, finish_plan, prepare
 
 __all__ = ["plan_exact", "EXACT_METHODS"]
 
 EXACT_METHODS = ("dijkstra", "astar")
 MAX_EXPANDED_NODES = 8_000_000
 """Above this many time-expanded nodes (poses × obstacle period), "dijkstra" hands over to the lazy A*."""
+
+_GRAPH_BYTES = 40
+"""Peak bytes per (pose, command) entry of building the CSR search graph and running scipy's Dijkstra
+over it, beyond the simulator's tables (measured: 34 to 37 on maps of 50 x 50 to 350 x 350 cells;
+tests/solvers/grid_paths/test_exact.py compares the estimate with tracemalloc's peak)."""
+_MASK_BYTES = 3
+"""Peak bytes per (pose, command) entry of A*'s usable-command mask and its temporaries."""
+_ASTAR_BYTES = 200
+"""Bytes per pose of A*'s heap and dictionaries when it reaches every pose, as it does when the goal
+cannot be reached (measured: 183)."""
+
+
+def _search(method: str, n_poses: int, n_commands: int, period: int, tables: int) -> str:
+    """The search that runs: "dijkstra" hands a time-expanded graph too large for memory (more than
+    :data:`MAX_EXPANDED_NODES` nodes, or beyond the memory budget with the ``tables`` of the simulator)
+    to A*."""
+    if method != "dijkstra" or period == 1:
+        return method
+    expanded = tables + _search_bytes(n_poses, n_commands, "dijkstra", period)
+    return "astar" if n_poses * period > MAX_EXPANDED_NODES or expanded > memory_budget() else method
+
+
+def _search_bytes(n_poses: int, n_commands: int, search: str, period: int) -> int:
+    """Peak bytes of the search beyond the simulator: the CSR graph (time-expanded over the moving
+    obstacles' period) for Dijkstra; for A*, the usable mask and its search state with every pose
+    reached once; plus the static graph that tells an unreachable leg at once when obstacles move."""
+    entries = n_poses * n_commands
+    static = entries * _GRAPH_BYTES if period > 1 else 0
+    if search == "dijkstra":
+        return static + entries * _GRAPH_BYTES * period
+    return static + entries * _MASK_BYTES + n_poses * _ASTAR_BYTES
+
+
+def _check_memory(workspace: Workspace | Simulator, method: str, commands, diagonals) -> str:
+    """The search to run; refuse, before compiling anything, a plan whose tables and graph would not
+    fit the memory budget."""
+    compiled = isinstance(workspace, Simulator)
+    ws = workspace.workspace if compiled else workspace
+    if compiled:
+        n_poses, n_commands = workspace.n_poses, workspace.n_commands
+    else:
+        n_poses, n_commands = table_shape(workspace, commands=commands, diagonals=diagonals)
+    cells = ws.width * ws.height
+    per_cell, period = n_poses // cells, ws.period if ws.moving else 1
+
+    def tables(c: int) -> int:  # a given simulator's tables exist already; the plan never repairs
+        return 0 if compiled else compile_bytes(c * per_cell, n_commands, repair=False)
+
+    def need(c: int, search: str) -> int:
+        return tables(c) + _search_bytes(c * per_cell, n_commands, search, period)
+
+    search = _search(method, n_poses, n_commands, period, tables(cells))
+    needed = need(cells, search)
+    advice = f"{search!r} fits {map_text(cells_within(lambda c: need(c, search)))} with these commands"
+    if search == "dijkstra":
+        astar = need(cells, "astar")
+        advice += (f"; method='astar' fits this map (about {size_text(astar)})" if astar <= memory_budget()
+                   else f"; method='astar' fits {map_text(cells_within(lambda c: need(c, 'astar')))}")
+    check_memory(needed, f"exact planning ({search}) on this {ws.width} x {ws.height} map ({per_cell} poses a cell, "
+                         f"{n_commands} commands)", advice + "; or use a smaller map or coarser cells")
+    return search
 
 
 class _Graph:
@@ -197,7 +273,7 @@ def plan_exact(
     roadmap : sequence of Pose
         Start first, goal last, at least two configurations.
     diagonals : bool, keyword-only
-        Allow the four diagonal translations (seed 001).
+        Allow the four diagonal translations (Do et al. 2021).
     commands : sequence of str, optional, keyword-only
         Command tokens to plan with (default: Cheng et al. 2020's set, plus diagonals when asked).
     timing : Timing, optional, keyword-only
@@ -218,9 +294,13 @@ def plan_exact(
     Raises
     ------
     ParameterError
-        If the method is unknown or ``t0`` is not a non-negative integer.
+        If the method is unknown, ``t0`` is not a non-negative integer, or an argument has the
+        wrong type.
     PlanningError
-        If the roadmap has fewer than two configurations.
+        If the roadmap has fewer than two configurations, or the simulator's tables and the search
+        graph would need more memory than the budget
+        (:func:`~htetro_opt.model.simulate.memory_budget`): the message says how much, and which
+        map size, or A*, would fit. Nothing is allocated before this check.
     ConfigurationError
         If the start collides or a configuration is outside the map.
 
@@ -234,14 +314,14 @@ def plan_exact(
     if method not in EXACT_METHODS:
         raise ParameterError(f"unknown exact method {method!r}: expected one of {', '.join(EXACT_METHODS)}")
     t0 = check_int(t0, "t0", minimum=0)
+    check_map(workspace)
+    roadmap = check_roadmap(roadmap)
+    search = _check_memory(workspace, method, commands, diagonals)
     began = _time.perf_counter()
     sim, roadmap, ids = prepare(workspace, roadmap, t0=t0, commands=commands, diagonals=diagonals,
                                 timing=timing, clearance=clearance)
     graph = _Graph(sim)
     moving = bool(sim.workspace.moving)
-    search = method
-    if method == "dijkstra" and moving and sim.n_poses * sim.workspace.period > MAX_EXPANDED_NODES:
-        search = "astar"
     static = _Graph(sim, static=True) if moving else graph
     has_diagonals = any(COMMANDS[int(c)].kind == "diagonal" for c in sim.command_ids)
     per_cell = min(

@@ -16,6 +16,7 @@ from typing import Mapping, Sequence
 import numpy as np
 from pymoo.optimize import minimize
 
+from htetro_opt._progress import check_progress, report
 from htetro_opt._validation import check_bool, check_int, check_seed
 from htetro_opt.algorithms import (
     ConvergenceRecorder,
@@ -27,11 +28,11 @@ from htetro_opt.algorithms import (
 from htetro_opt.model.commands import SEED000_COMMANDS, Timing
 from htetro_opt.model.robot import Pose
 from htetro_opt.model.simulate import Simulator
-from htetro_opt.model.workspace import Workspace
+from htetro_opt.model.workspace import Workspace, grid_distance
 from htetro_opt.problems.command_path import CommandPathProblem
 from htetro_opt.solvers.grid_paths._result import FrontMember, LegResult, Plan, finish_plan, prepare
 
-__all__ = ["plan_ga"]
+__all__ = ["plan_ga", "default_max_length", "DEFAULT_MAX_LENGTH"]
 
 
 def _members(problem: CommandPathProblem, X: np.ndarray, F: np.ndarray) -> list[FrontMember]:
@@ -42,6 +43,38 @@ def _members(problem: CommandPathProblem, X: np.ndarray, F: np.ndarray) -> list[
             for i in range(len(X))]
 
 
+DEFAULT_MAX_LENGTH = 100
+"""The paper's l_p,max, the least default of :func:`plan_ga`'s ``max_length``."""
+
+
+def default_max_length(workspace: Workspace, start: Pose, goal: Pose) -> int:
+    """l_p,max for one leg: the larger of :data:`DEFAULT_MAX_LENGTH` and twice the 4-connected grid
+    distance between the leg's B2 cells (unreachable cells: the map's free cell count).
+
+    Examples
+    --------
+    >>> default_max_length(Workspace(np.zeros((200, 200), dtype=bool)), Pose(1, 1, "O", 0), Pose(150, 120, "O", 0))
+    536
+    """
+    distance = grid_distance(workspace, (goal.x, goal.y))[start.y, start.x]
+    if not np.isfinite(distance):
+        distance = int((~workspace.occupancy).sum())
+    return max(DEFAULT_MAX_LENGTH, int(np.ceil(2 * distance)))
+
+
+def _reporter(progress, leg: int, legs: int, max_gen: int):
+    """The recorder's per-generation hook that reports to ``progress``."""
+    if progress is None:
+        return None
+
+    def on_generation(generation: int, best_f_t: float | None, reached: bool) -> None:
+        where = f"leg {leg + 1}/{legs}: " if legs > 1 else ""
+        best = f"best f_t {best_f_t:.3f}" if best_f_t is not None else "goal not reached yet"
+        report(progress, generation, max_gen, where + best)
+
+    return on_generation
+
+
 def plan_ga(
     workspace: Workspace | Simulator,
     roadmap: Sequence[Pose],
@@ -50,13 +83,14 @@ def plan_ga(
     pop_size: int = 50,
     max_gen: int = 1000,
     patience: int = 100,
-    max_length: int = 100,
+    max_length: int | None = None,
     seed=0,
     sampling_weights: Mapping[str, float] | None = None,
     commands: Sequence[str] | None = None,
     timing: Timing | None = None,
     clearance: float = 0.0,
     verbose: bool = False,
+    progress=None,
 ) -> Plan:
     """Plan through a roadmap with a command-chromosome GA, one optimisation per leg.
 
@@ -74,8 +108,11 @@ def plan_ga(
     max_gen, patience : int, keyword-only
         Termination (:class:`~htetro_opt.algorithms.FrontConvergence`): at most ``max_gen``
         generations per leg, or ``patience`` generations without improvement once the goal is reached.
-    max_length : int, keyword-only
-        l_p,max (the paper: 100, 200 for the spiral map).
+    max_length : int, optional, keyword-only
+        l_p,max, the length of the initial chromosomes and, through t_max, the scale of f_t (the
+        paper: 100, 200 for its spiral map). By default, per leg, the larger of 100 and twice the
+        4-connected grid distance from the leg's start cell to its goal cell (ours: on a large map a
+        fixed 100 is shorter than any path, and f_t goes negative).
     seed : None, int or numpy.random.Generator, keyword-only
         One seed for the whole run (each leg gets its own stream derived from it); the same int gives
         the same plan; None draws fresh entropy.
@@ -85,6 +122,9 @@ def plan_ga(
         As for :class:`~htetro_opt.model.Simulator` (commands default to Cheng et al. 2020's set).
     verbose : bool, keyword-only
         Print pymoo's per-generation log.
+    progress : callable, optional, keyword-only
+        ``progress(generation, max_gen, note)`` after every generation, the note giving the leg and
+        the best f_t reached so far (see :mod:`htetro_opt._progress`).
 
     Returns
     -------
@@ -114,7 +154,8 @@ def plan_ga(
     make_algorithm(algorithm, pop_size)  # validates the name and size before any work
     max_gen = check_int(max_gen, "max_gen", minimum=1)
     patience = check_int(patience, "patience", minimum=1)
-    max_length = check_int(max_length, "max_length", minimum=1)
+    max_length = check_int(max_length, "max_length", minimum=1, allow_none=True)
+    progress = check_progress(progress)
     seed = check_seed(seed)
     verbose = check_bool(verbose, "verbose")
     began = _time.perf_counter()
@@ -129,8 +170,9 @@ def plan_ga(
     failed, start, t0 = -1, roadmap[0], 0
     for leg, goal in enumerate(roadmap[1:]):
         leg_began = _time.perf_counter()
-        problem = CommandPathProblem(sim, start, goal, max_length=max_length, t0=t0)
-        recorder = ConvergenceRecorder(leg_began)
+        length = max_length if max_length is not None else default_max_length(sim.workspace, start, goal)
+        problem = CommandPathProblem(sim, start, goal, max_length=length, t0=t0)
+        recorder = ConvergenceRecorder(leg_began, _reporter(progress, leg, len(roadmap) - 1, max_gen))
         termination = FrontConvergence(max_gen=max_gen, patience=patience)
         res = minimize(problem, make_algorithm(algorithm, pop_size, sampling_weights=sampling_weights),
                        termination, seed=int(leg_seeds[leg]), callback=recorder, verbose=verbose)

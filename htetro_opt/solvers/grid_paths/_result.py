@@ -8,20 +8,21 @@ cannot report a time, a pose or a validity its commands do not have.
 from __future__ import annotations
 
 import math
+import reprlib
 import time
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Mapping, Sequence
 
 import numpy as np
 
-from htetro_opt.errors import PlanningError
+from htetro_opt.errors import ParameterError, PlanningError
 from htetro_opt.model.commands import COMMANDS
-from htetro_opt.model.robot import Pose
+from htetro_opt.model.robot import Pose, as_pose
 from htetro_opt.model.simulate import Simulator
-from htetro_opt.model.workspace import Workspace
+from htetro_opt.model.workspace import Workspace, check_workspace
 from htetro_opt.problems.command_path import FITNESS_NAMES
 
-__all__ = ["Plan", "FrontMember", "LegResult", "finish_plan", "prepare"]
+__all__ = ["Plan", "FrontMember", "LegResult", "finish_plan", "prepare", "check_roadmap", "check_map"]
 
 
 @dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
@@ -127,7 +128,7 @@ class Plan:
     def objectives(self) -> dict:
         """Path metrics: time, number of commands by kind, B2's travelled distance.
 
-        Seed 004's ``2l/2r`` count as rotations, its other block commands as shapeshifts.
+        Cheng et al. 2019's ``2l/2r`` count as rotations, its other block commands as shapeshifts.
         """
         commands = [COMMANDS[int(c)] for c in self.commands]
         moves = [c for c in commands if c.kind in ("translation", "diagonal")]
@@ -170,21 +171,55 @@ def finish_plan(sim: Simulator, commands: np.ndarray, start: int, *, t0: int = 0
     )
 
 
-def prepare(workspace: Workspace | Simulator, roadmap: Sequence[Pose], *, t0: int = 0,
-            **compile_options) -> tuple[Simulator, list[Pose], list[int]]:
-    """The simulator (compiled unless given), the roadmap as poses and their pose ids, all checked
-    before any planning starts.
+def check_roadmap(roadmap) -> list[Pose]:
+    """A roadmap as a list of at least two poses (start first, goal last), checked before any work.
 
     Raises
     ------
+    ParameterError
+        If ``roadmap`` is not a sequence.
     PlanningError
-        If the roadmap has fewer than two configurations.
+        If it has fewer than two configurations.
+    ConfigurationError, UnknownShapeError
+        If an entry is not a pose, naming it (``roadmap[i]``).
+    """
+    if isinstance(roadmap, (str, bytes, Pose)) or not isinstance(roadmap, Iterable):
+        raise ParameterError(f"roadmap must be a sequence of poses (start first, goal last), "
+                             f"got {type(roadmap).__name__} {reprlib.repr(roadmap)}")
+    roadmap = [as_pose(p, f"roadmap[{i}]") for i, p in enumerate(roadmap)]
+    if len(roadmap) < 2:
+        raise PlanningError("a roadmap needs a start and a goal (at least two configurations)")
+    return roadmap
+
+
+def check_map(workspace) -> Workspace | Simulator:
+    """``workspace`` itself if it is a Workspace or a compiled Simulator.
+
+    Raises
+    ------
+    ParameterError
+        Naming what it got.
+    """
+    return workspace if isinstance(workspace, Simulator) else check_workspace(workspace, what="a Workspace or a Simulator")
+
+
+def prepare(workspace: Workspace | Simulator, roadmap: Sequence[Pose], *, t0: int = 0,
+            **compile_options) -> tuple[Simulator, list[Pose], list[int]]:
+    """The simulator (compiled unless given), the roadmap as poses and their pose ids, all checked
+    before any planning starts (the workspace and roadmap before the simulator is compiled).
+
+    Raises
+    ------
+    ParameterError
+        If ``workspace`` is neither a Workspace nor a Simulator, or ``roadmap`` is not a sequence.
+    PlanningError
+        If the roadmap has fewer than two configurations, or the simulator's tables would not fit
+        the memory budget.
     ConfigurationError
         If the start collides (at time ``t0``) or a configuration lies outside the map.
     """
-    roadmap = [Pose.of(*p) for p in roadmap]
-    if len(roadmap) < 2:
-        raise PlanningError("a roadmap needs a start and a goal (at least two configurations)")
+    check_map(workspace)
+    roadmap = check_roadmap(roadmap)
     sim = workspace if isinstance(workspace, Simulator) else Simulator(workspace, **compile_options)
     ids = [sim.check_pose(roadmap[0], what="start", t=t0)]
     for i, pose in enumerate(roadmap[1:], start=1):

@@ -19,7 +19,7 @@ from htetro_opt._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
     "sequence_waypoints": "._dispatch", "SequenceResult": "._dispatch", "SEQUENCE_METHODS": "._dispatch",
-    "EXACT_AUTO_LIMIT": "._dispatch",
+    "EXACT_AUTO_LIMIT": "._dispatch", "default_time_limit": "._budgets", "TIME_LIMIT_TEXT": "._budgets",
     "solve_exact": "._exact", "held_karp": "._exact", "EXACT_MAX_SIZE": "._exact",
     "solve_ortools": "._ortools", "ortools_time_limit": "._ortools", "FIRST_SOLUTIONS": "._ortools",
     "solve_local": "._local", "nearest_neighbour": "._local", "nearest_neighbour_paths": "._local",

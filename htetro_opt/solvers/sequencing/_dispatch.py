@@ -10,15 +10,17 @@ is a method too.
 
 from __future__ import annotations
 
+import inspect
 import time
 from dataclasses import dataclass, field
 from importlib import import_module
 
 import numpy as np
 
+from htetro_opt._progress import check_progress
 from htetro_opt._validation import check_seed, check_time_limit
 from htetro_opt.errors import ParameterError
-from htetro_opt.problems.waypoint_sequencing import SequencingInstance
+from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance
 
 __all__ = ["SEQUENCE_METHODS", "EXACT_AUTO_LIMIT", "SequenceResult", "sequence_waypoints"]
 
@@ -64,6 +66,15 @@ class SequenceResult:
                 "runtime_s": round(self.runtime_s, 6), **self.info}
 
 
+def _takes(function, keyword: str) -> bool:
+    """Whether ``function`` accepts ``keyword`` (by name or through ``**kwargs``)."""
+    try:
+        parameters = inspect.signature(function).parameters.values()
+    except (TypeError, ValueError):  # some builtins have no signature
+        return False
+    return any(p.name == keyword or p.kind is p.VAR_KEYWORD for p in parameters)
+
+
 def _resolve(method, n: int) -> tuple[str, object, dict]:
     if callable(method):
         return getattr(method, "__name__", type(method).__name__), method, {}
@@ -77,7 +88,7 @@ def _resolve(method, n: int) -> tuple[str, object, dict]:
 
 
 def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, time_limit: float | None = None,
-                       **options) -> SequenceResult:
+                       progress=None, **options) -> SequenceResult:
     """Order the waypoints of an instance with one method.
 
     Parameters
@@ -92,10 +103,14 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, t
         Seed of the stochastic methods (the deterministic ones and ortools, which has no seed,
         check it and ignore it): an int or a Generator reproduces a run, None draws fresh entropy.
     time_limit : float, optional, keyword-only
-        Wall-clock budget in seconds for the methods that take one (exact, ortools, ga, local,
-        greedy): a positive, finite number; None: the method's own default (60 s for exact,
-        :func:`~htetro_opt.solvers.sequencing.ortools_time_limit` for ortools, no limit for the
-        others).
+        Wall-clock budget in seconds for the methods that take one (exact, ortools, ga, ga-plain,
+        local, greedy): a positive, finite number; None: the method's default, sized to the instance
+        (:func:`default_time_limit`: exact 60 s; ortools 1 s up to 20 waypoints,
+        rising to 30 s at 40; ga, ga-plain 10 s + 1 s per 50 waypoints, at most 60 s; greedy 10 s + 1 s
+        per 100 waypoints, at most 30 s; local 10 s + 1 s per 100 waypoints, at most 120 s).
+    progress : callable, optional, keyword-only
+        ``progress(done, total, note)`` from the methods that report (ga, ga-plain, greedy, local,
+        ortools; a callable method that takes a ``progress`` keyword), see :mod:`htetro_opt._progress`.
     **options
         Passed to the method (e.g. ``pop_size`` for ``ga``, ``iterations`` for ``greedy``).
 
@@ -106,7 +121,8 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, t
     Raises
     ------
     ParameterError
-        On an unknown method or option value (an infinite ``time_limit`` among them).
+        On an unknown method or option value (an infinite ``time_limit`` among them), or an
+        ``instance`` that is not a :class:`SequencingInstance`.
 
     Examples
     --------
@@ -116,9 +132,13 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, t
     >>> result.tiles, result.cost
     ([3, 2, 1], 2.0)
     """
+    check_instance(instance)
     time_limit = check_time_limit(time_limit)
     seed = check_seed(seed)
+    progress = check_progress(progress)
     name, function, preset = _resolve(method, instance.n)
+    if progress is not None and _takes(function, "progress"):
+        options = {**options, "progress": progress}
     began = time.perf_counter()
     order, info = function(instance, seed=seed, time_limit=time_limit, **{**preset, **options})
     runtime = time.perf_counter() - began

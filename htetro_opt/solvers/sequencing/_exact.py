@@ -27,7 +27,7 @@ import numpy as np
 from htetro_opt._interrupt import on_signal
 from htetro_opt._validation import check_int, check_time_limit, derive_seed
 from htetro_opt.errors import ParameterError, PlanningError
-from htetro_opt.problems.waypoint_sequencing import SequencingInstance, path_cost
+from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance, path_cost
 from htetro_opt.solvers.sequencing._local import _check_square, nearest_neighbour_paths
 
 __all__ = [
@@ -113,6 +113,7 @@ def solve_exact(instance: SequencingInstance, *, seed=0, time_limit: float | Non
     >>> order.tolist(), info["optimal"], inst.path_cost(order)
     ([1, 0, 2], True, 3.0)
     """
+    instance = check_instance(instance)
     limit = check_time_limit(time_limit)
     limit = EXACT_TIME_LIMIT if limit is None else limit
     random_seed = derive_seed(seed)

@@ -43,9 +43,11 @@ import time
 import numpy as np
 from deap import base
 
+from htetro_opt._progress import check_progress, report
 from htetro_opt._validation import check_bool, check_int, check_probability, check_time_limit, derive_seed
 from htetro_opt.operators.permutation import Tour, order_crossover, select_tournament, swap_mutation
-from htetro_opt.problems.waypoint_sequencing import path_cost
+from htetro_opt.problems.waypoint_sequencing import check_instance, path_cost
+from htetro_opt.solvers.sequencing._budgets import default_time_limit
 from htetro_opt.solvers.sequencing._local import (
     _check_cost,
     _improve_rows,
@@ -77,6 +79,7 @@ def make_toolbox(instance, rng: random.Random, *, tournament_size: int = 3) -> b
     >>> tb.evaluate(pop), tb.orders(pop).tolist(), [t.fitness.values[0] for t in pop]
     (2, [[1, 2, 0], [1, 0, 2]], [3.0, 3.0])
     """
+    instance = check_instance(instance)
     cost = np.asarray(instance.cost, dtype=float)
     start = instance.start
     genes = [i for i in range(instance.n) if i != start]
@@ -140,7 +143,7 @@ def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool
              pop_size: int = 60, max_gen: int = 2000, patience: int | None = 200,
              crossover_rate: float = 0.8, mutation_rate: float = 0.2, tournament_size: int = 3,
              elite: int | None = None, local_search_rate: float = 0.25,
-             local_search_rounds: int | None = None) -> tuple[np.ndarray, dict]:
+             local_search_rounds: int | None = None, progress=None) -> tuple[np.ndarray, dict]:
     """Order the waypoints with the paper's GA (Algorithm 2), optionally memetic.
 
     Parameters
@@ -153,7 +156,7 @@ def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool
         draws fresh entropy.
     time_limit : float, optional
         Wall-clock budget in seconds; checked every generation (and between local-search rounds).
-        None: no limit.
+        None: 10 s + 1 s per 50 waypoints, at most 60 s.
     memetic : bool
         Improve children with the 2-opt/Or-opt local search before they compete.
     pop_size : int
@@ -176,6 +179,8 @@ def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool
         local search improves.
     local_search_rounds : int or None
         Memetic only: the budget of best-move rounds per local search (None: to the local optimum).
+    progress : callable, optional
+        ``progress(generation, max_gen, note)`` after every generation, the note giving the best cost.
 
     Returns
     -------
@@ -203,9 +208,13 @@ def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool
     >>> inst.path_cost(order)
     5.0
     """
+    instance = check_instance(instance)
     rng = random.Random(derive_seed(seed))
-    time_limit = check_time_limit(time_limit)
     memetic = check_bool(memetic, "memetic")
+    time_limit = check_time_limit(time_limit)
+    if time_limit is None:
+        time_limit = default_time_limit("ga" if memetic else "ga-plain", instance.n)
+    progress = check_progress(progress)
     pop_size = check_int(pop_size, "pop_size", minimum=2)
     max_gen = check_int(max_gen, "max_gen", minimum=0)
     patience = check_int(patience, "patience", minimum=1, allow_none=True)
@@ -219,11 +228,11 @@ def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool
     cost = _check_cost(instance.cost)
 
     began = time.perf_counter()
-    deadline = math.inf if time_limit is None else began + time_limit
+    deadline = began + time_limit
     toolbox = make_toolbox(instance, rng, tournament_size=tournament_size)
     fixed = instance.start is not None
     info = {"generations": 0, "evaluations": 0, "memetic": memetic, "best_generation": 0,
-            "stopped": "max_gen"}
+            "stopped": "max_gen", "time_limit_s": time_limit}
     if instance.n - fixed <= 1:  # nothing to order
         pop = toolbox.population(1)
         info["evaluations"] = toolbox.evaluate(pop)
@@ -264,6 +273,7 @@ def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool
             local_search(fresh)
         pop = _reduce(pop, offspring, pop_size, elite)
         leader = min(pop, key=_cost_of)
+        report(progress, generation, max_gen, f"best cost {min(_cost_of(leader), _cost_of(best)):.4g}")
         if _cost_of(leader) < _cost_of(best) - tol:
             best, stale = leader.copy(), 0
             info["best_generation"] = generation

@@ -39,12 +39,16 @@ than ``1e-9 × max |cost|`` are ignored, so rounding noise never cycles.
 from __future__ import annotations
 
 import math
+import reprlib
 import time
 
 import numpy as np
 
-from htetro_opt._validation import as_rng, check_int, check_time_limit
+from htetro_opt._progress import check_progress, report
+from htetro_opt._validation import as_rng, check_bool, check_int, check_real, check_time_limit
 from htetro_opt.errors import ParameterError
+from htetro_opt.problems.waypoint_sequencing import check_instance
+from htetro_opt.solvers.sequencing._budgets import default_time_limit
 
 __all__ = [
     "NEIGHBOURS",
@@ -426,7 +430,10 @@ def nearest_neighbour_paths(cost, firsts, *, seconds=None, priority=None) -> np.
             raise ParameterError(f"seconds must hold one waypoint per path ({k}), -1 or other than its first, "
                                  f"got {seconds.tolist()}")
     if priority is not None:
-        priority = np.asarray(priority, dtype=float)
+        try:
+            priority = np.asarray(priority, dtype=float)
+        except (TypeError, ValueError) as err:
+            raise ParameterError(f"priority must be a ({k}, {n}) array of numbers, got {reprlib.repr(priority)}") from err
         if priority.shape != (k, n):
             raise ParameterError(f"priority must have shape ({k}, {n}), one row per path, got {priority.shape}")
     rows = np.arange(k)
@@ -554,6 +561,7 @@ def two_opt(cost, order, *, fixed_start: bool = True, max_rounds: int | None = N
     """
     C = _check_cost(cost)
     p = _check_order(order, len(C))
+    fixed_start = check_bool(fixed_start, "fixed_start")
     search = _Search(C, fixed_start, max_rounds=_check_rounds(max_rounds))
     return _unpad(search.descend(_pad(p, len(C), fixed_start), [search.two_opt_round]), fixed_start)
 
@@ -597,6 +605,7 @@ def or_opt(cost, order, *, fixed_start: bool = True, segment_lengths=(1, 2, 3),
     """
     C = _check_cost(cost)
     p = _check_order(order, len(C))
+    fixed_start = check_bool(fixed_start, "fixed_start")
     lengths = _check_lengths(segment_lengths)
     search = _Search(C, fixed_start, lengths, max_rounds=_check_rounds(max_rounds))
     return _unpad(search.descend(_pad(p, len(C), fixed_start), [search.or_opt_round]), fixed_start)
@@ -639,6 +648,7 @@ def improve(cost, order, *, fixed_start: bool = True, segment_lengths=(1, 2, 3),
     """
     C = _check_cost(cost)
     p = _check_order(order, len(C))
+    fixed_start = check_bool(fixed_start, "fixed_start")
     lengths = _check_lengths(segment_lengths)
     search = _Search(C, fixed_start, lengths, max_rounds=_check_rounds(max_rounds))
     q = search.descend(_pad(p, len(C), fixed_start), [search.two_opt_round, search.or_opt_round])
@@ -658,8 +668,8 @@ def double_bridge(order, rng, *, fixed_start: bool = True) -> np.ndarray:
     [0, 1, 2, 4, 5, 3, 6, 7]
     """
     rng = as_rng(rng, "rng")
-    p = np.asarray(order, dtype=np.int64)
-    lo = 1 if fixed_start else 0
+    p = _check_order(order, np.size(order))
+    lo = 1 if check_bool(fixed_start, "fixed_start") else 0
     if len(p) - lo - 1 < 3:
         return p.copy()
     a, b, c = np.sort(rng.choice(np.arange(lo + 1, len(p)), 3, replace=False))
@@ -699,9 +709,18 @@ def improve_batch(cost, orders, *, fixed_start: bool = True, segment_lengths=(1,
     """
     C = _check_cost(cost)
     n = len(C)
-    P = np.array(orders, dtype=np.int64).reshape(-1, n)
+    try:
+        P = np.array(orders)
+        if P.size and not np.issubdtype(P.dtype, np.integer):
+            raise ValueError
+        P = P.astype(np.int64).reshape(-1, n)
+    except (TypeError, ValueError) as err:
+        raise ParameterError(f"orders must be rows of waypoint indices, each a permutation of 0…{n - 1}, "
+                             f"got {reprlib.repr(orders)}") from err
     for p in P:
         _check_order(p, n)
+    fixed_start = check_bool(fixed_start, "fixed_start")
+    deadline = check_real(deadline, "deadline (a time.perf_counter() instant)", finite=False)
     lengths = _check_lengths(segment_lengths)
     rounds = _check_rounds(max_rounds)
     return _improve_rows(_padded_cost(C), _tolerance(C), P, fixed_start, lengths, rounds, deadline)
@@ -805,7 +824,7 @@ def _batch_or_opt(Q: np.ndarray, lengths):
 
 
 def solve_local(instance, *, seed=0, time_limit: float | None = None, restarts: int = 0,
-                max_starts: int = 32) -> tuple[np.ndarray, dict]:
+                max_starts: int = 32, progress=None) -> tuple[np.ndarray, dict]:
     """Nearest neighbour, then 2-opt/Or-opt to a local optimum; optionally iterated local search.
 
     With ``restarts > 0``, each restart kicks the best order so far with a :func:`double_bridge`
@@ -820,11 +839,13 @@ def solve_local(instance, *, seed=0, time_limit: float | None = None, restarts: 
         ``time_limit`` cuts it short), None draws fresh entropy.
     time_limit : float, optional
         Wall-clock budget in seconds: no round or restart starts after it (the nearest-neighbour
-        construction always completes). None: no limit.
+        construction always completes). None: 10 s + 1 s per 100 waypoints, at most 120 s.
     restarts : int
         Number of kicks of the iterated local search (0: plain local search).
     max_starts : int
         Passed to :func:`nearest_neighbour` for a free start.
+    progress : callable, optional
+        ``progress(restarts done, restarts, note)`` after the first descent and each restart.
 
     Returns
     -------
@@ -847,11 +868,15 @@ def solve_local(instance, *, seed=0, time_limit: float | None = None, restarts: 
     >>> order.tolist(), info["initial_cost"], inst.path_cost(order)
     ([0, 2, 4, 5, 3, 1], 5.0, 5.0)
     """
+    instance = check_instance(instance)
     restarts = check_int(restarts, "restarts", minimum=0)
     rng = as_rng(seed)
     time_limit = check_time_limit(time_limit)
+    if time_limit is None:
+        time_limit = default_time_limit("local", instance.n)
+    progress = check_progress(progress)
     began = time.perf_counter()
-    deadline = math.inf if time_limit is None else began + time_limit
+    deadline = began + time_limit
     C = _check_cost(instance.cost)
     n = len(C)
     fixed = instance.start is not None
@@ -863,6 +888,7 @@ def solve_local(instance, *, seed=0, time_limit: float | None = None, restarts: 
     best_cost = _path_cost(C, best)
     info["local_optimum_cost"] = float(best_cost)
     done = improving = 0
+    report(progress, 0, restarts, f"local optimum {best_cost:.4g}")
     while done < restarts and time.perf_counter() < deadline:
         done += 1
         kicked = double_bridge(best, rng, fixed_start=fixed)
@@ -871,9 +897,11 @@ def solve_local(instance, *, seed=0, time_limit: float | None = None, restarts: 
         cost = _path_cost(C, candidate)
         if cost < best_cost - search.tol:
             best, best_cost, improving = candidate, cost, improving + 1
+        report(progress, done, restarts, f"best cost {best_cost:.4g}")
     if improving:
         best = _unpad(search.descend(_pad(best, n, fixed), moves), fixed)
-    info.update(restarts=done, improving_restarts=improving, timed_out=time.perf_counter() >= deadline)
+    info.update(restarts=done, improving_restarts=improving, timed_out=time.perf_counter() >= deadline,
+                time_limit_s=time_limit)
     return best, info
 
 

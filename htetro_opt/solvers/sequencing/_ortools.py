@@ -24,12 +24,15 @@ the ``local`` method's iterated local search found in 10 s.
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from htetro_opt._interrupt import on_signal
+from htetro_opt._progress import check_progress, report
 from htetro_opt._validation import check_real, check_seed, check_time_limit
 from htetro_opt.errors import ParameterError, PlanningError
-from htetro_opt.problems.waypoint_sequencing import SequencingInstance
+from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance
 
 __all__ = ["FIRST_SOLUTIONS", "ORTOOLS_COST_RESOLUTION", "ortools_time_limit", "solve_ortools"]
 
@@ -71,7 +74,8 @@ def ortools_time_limit(n: int) -> float:
 
 
 def solve_ortools(instance: SequencingInstance, *, seed=0, time_limit: float | None = None,
-                  scale: float | None = None, first_solution: str = "PATH_CHEAPEST_ARC") -> tuple[np.ndarray, dict]:
+                  scale: float | None = None, first_solution: str = "PATH_CHEAPEST_ARC",
+                  progress=None) -> tuple[np.ndarray, dict]:
     """A near-optimal order of an instance's waypoints by OR-Tools routing with guided local search.
 
     Parameters
@@ -90,6 +94,9 @@ def solve_ortools(instance: SequencingInstance, *, seed=0, time_limit: float | N
         then within ``(n − 1) / (2 · scale)`` of its true cost.
     first_solution : str
         One of :data:`FIRST_SOLUTIONS`.
+    progress : callable, optional
+        ``progress(seconds spent, time limit, note)`` at most five times a second, the note giving the
+        cost of the solution the search is at.
 
     Returns
     -------
@@ -114,10 +121,12 @@ def solve_ortools(instance: SequencingInstance, *, seed=0, time_limit: float | N
     >>> int(order[0]), inst.path_cost(order)  # from tile 2, then tile 1 or tile 3: both cost 3
     (1, 3.0)
     """
+    instance = check_instance(instance)
     n = instance.n
     check_seed(seed)
     limit = check_time_limit(time_limit)
     limit = ortools_time_limit(n) if limit is None else limit
+    progress = check_progress(progress)
     if not isinstance(first_solution, str) or first_solution.upper() not in FIRST_SOLUTIONS:
         raise ParameterError(f"first_solution must be one of {', '.join(FIRST_SOLUTIONS)}; got {first_solution!r}")
     top = float(np.abs(instance.cost).max())
@@ -153,14 +162,20 @@ def solve_ortools(instance: SequencingInstance, *, seed=0, time_limit: float | N
     params.first_solution_strategy = getattr(routing_enums_pb2.FirstSolutionStrategy, first_solution.upper())
     params.local_search_metaheuristic = routing_enums_pb2.LocalSearchMetaheuristic.GUIDED_LOCAL_SEARCH
     params.time_limit.FromMilliseconds(max(1, round(limit * 1000)))
+    began = time.perf_counter()
+    last_report = [began]
     with on_signal() as interrupted:
-        def finish_if_interrupted() -> None:
+        def at_solution() -> None:
             # Guided local search only stops at its time limit: end it at the next solution it visits
             # (measured at most ~0.2 s apart on 1000 waypoints) once Ctrl-C or SIGTERM has arrived.
             if interrupted.is_set():
                 routing.solver().FinishCurrentSearch()
+            now = time.perf_counter()
+            if progress is not None and now - last_report[0] >= 0.2:  # thousands of solutions a second
+                last_report[0] = now
+                report(progress, round(now - began, 1), limit, f"cost {routing.CostVar().Value() / factor:.4g}")
 
-        routing.AddAtSolutionCallback(finish_if_interrupted)
+        routing.AddAtSolutionCallback(at_solution)
         solution = routing.SolveWithParameters(params)
     status = routing_enums_pb2.RoutingSearchStatus.Value.Name(routing.status())
     if solution is None:

@@ -80,6 +80,7 @@ Examples
 from __future__ import annotations
 
 import functools
+import reprlib
 import time as _time
 from hashlib import blake2b
 
@@ -88,7 +89,7 @@ from scipy import ndimage
 
 from htetro_opt._interrupt import on_signal
 from htetro_opt._validation import check_bool, check_int, check_seed, check_time_limit, derive_seed
-from htetro_opt.errors import ParameterError, TilingError
+from htetro_opt.errors import ParameterError, ScenarioError, TilingError
 from htetro_opt.model.tiles import Pattern, patterns_of
 from htetro_opt.model.workspace import Workspace
 from htetro_opt.problems.waypoint_sequencing import (
@@ -133,22 +134,16 @@ class _TimeLimit(TilingError):
 # Validation
 
 
-def _as_occupancy(workspace) -> tuple[np.ndarray, float]:
+def _as_occupancy(workspace, name: str) -> tuple[np.ndarray, float]:
     if isinstance(workspace, Workspace):
         return workspace.occupancy, workspace.cell_size
     try:
-        occ = np.asarray(workspace)
-    except (TypeError, ValueError) as err:
-        raise ParameterError(
-            f"the workspace must be a Workspace or an (H, W) bool array, got {type(workspace).__name__}"
-        ) from err
-    if occ.ndim != 2 or 0 in occ.shape:
-        raise ParameterError(f"the occupancy must be a non-empty 2-D (H, W) array, got shape {occ.shape}")
-    if occ.dtype != bool:
-        if not np.issubdtype(occ.dtype, np.number) or not np.isin(occ, (0, 1)).all():
-            raise ParameterError("the occupancy must hold booleans (True = obstacle) or 0/1")
-        occ = occ.astype(bool)
-    return occ, 1.0
+        return Workspace(workspace).occupancy, 1.0
+    except ScenarioError as err:  # an argument here, not a file's content
+        got = (f"an array of shape {workspace.shape}" if isinstance(workspace, np.ndarray)
+               else f"{type(workspace).__name__} {reprlib.repr(workspace)}")
+        raise ParameterError(f"{name} must be a Workspace or a non-empty 2-D (H, W) array of booleans "
+                             f"(True = obstacle) or 0/1, got {got}") from err
 
 
 def _check_shapes(shapes) -> tuple[Pattern, ...]:
@@ -693,7 +688,7 @@ def find_tiles(occupancy, *, shapes=None, method: str = "backtracking", shuffle:
     >>> [t.tolist() for t in tiles]
     [[[0, 3], [1, 3], [0, 2], [1, 2]], [[0, 1], [1, 1], [0, 0], [1, 0]]]
     """
-    occ, _ = _as_occupancy(occupancy)
+    occ, _ = _as_occupancy(occupancy, "occupancy")
     patterns = _check_shapes(shapes)
     seed, deadline = _check_options(method, shuffle, seed, time_limit)
     try:
@@ -796,11 +791,13 @@ def tile_workspace(workspace, *, shapes=None, method: str = "backtracking", shuf
     >>> len(ts), int(ts.coverage().sum()), ts.complete
     (12, 48, True)
     """
-    occ, cell_size = _as_occupancy(workspace)
+    occ, cell_size = _as_occupancy(workspace, "workspace")
     patterns = _check_shapes(shapes)
     seed, deadline = _check_options(method, shuffle, seed, time_limit)
     check_weights(weights)
     overlap = check_bool(overlap, "overlap")
+    if not isinstance(name, str):
+        raise ParameterError(f"name must be a string, got {type(name).__name__} {reprlib.repr(name)}")
     try:
         try:
             tiles = _tilings(occ, patterns, method, seed, deadline, 1)[0]
@@ -851,7 +848,7 @@ def enumerate_tilings(workspace, *, shapes=None, limit: int = 10, method: str = 
     >>> len(enumerate_tilings(np.zeros((4, 4), dtype=bool), shapes="O", limit=5))
     1
     """
-    occ, cell_size = _as_occupancy(workspace)
+    occ, cell_size = _as_occupancy(workspace, "workspace")
     patterns = _check_shapes(shapes)
     limit = check_int(limit, "limit", minimum=1)
     _, deadline = _check_options(method, False, None, time_limit)

@@ -1,6 +1,10 @@
 """The exact planner: optimal against independent searches, and every plan re-validates."""
 
 import heapq
+import re
+import sys
+import time
+import tracemalloc
 from functools import partial
 
 import networkx as nx
@@ -10,7 +14,7 @@ import pytest
 from htetro_opt.errors import ConfigurationError, ParameterError, PlanningError
 from htetro_opt.model import SEED000_COMMANDS, MovingObstacle, Pose, Simulator, Workspace, shape_index
 from htetro_opt.scenarios import parse_grid
-from htetro_opt.solvers.grid_paths import EXACT_METHODS, plan_exact
+from htetro_opt.solvers.grid_paths import EXACT_METHODS, plan_exact, plan_path
 
 
 def as_tuple(pose):
@@ -225,3 +229,70 @@ def test_statically_unreachable_leg_is_reported_without_a_time_expanded_search()
     for method in EXACT_METHODS:
         plan = plan_exact(Workspace(occ, moving=moving), [Pose(2, 2, "O", 0), Pose(2, 8, "O", 0)], method=method)
         assert not plan.reached and plan.failed_leg == 0
+
+
+# --- the memory budget ---------------------------------------------------------------------------------
+
+SIMULATE = sys.modules["htetro_opt.model.simulate"]  # the module (htetro_opt.model.simulate is the function)
+
+
+@pytest.mark.parametrize("side", [1000, 5000])
+@pytest.mark.parametrize("method", ["dijkstra", "astar"])
+def test_a_huge_map_is_refused_at_once_saying_how_much_memory_and_what_fits(monkeypatch, side, method):
+    monkeypatch.setattr(Simulator, "_transition_table", lambda self: pytest.fail("allocated before the check"))
+    huge = Workspace(np.zeros((side, side), dtype=bool))
+    began = time.perf_counter()
+    with pytest.raises(PlanningError) as info:
+        plan_path(huge, [Pose(1, 1, "O", 0), Pose(side - 3, side - 3, "O", 0)], method=method)
+    assert time.perf_counter() - began < 2.0
+    message = str(info.value)
+    needed = float(re.search(r"would need about ([\d.]+) GiB of memory", message)[1])
+    budget = float(re.search(r"more than the budget of ([\d.]+) GiB", message)[1])
+    assert needed > budget > 0 and f"{side} x {side} map" in message
+    assert re.search(rf"'{method}' fits a map of at most [\d,]+ cells \(e\.g\. \d+ x \d+\)", message), message
+    if method == "dijkstra":
+        assert "method='astar' fits" in message
+
+
+def _needed_bytes(message):
+    number, unit = re.search(r"would need about ([\d.]+) (MiB|GiB) of memory", message).groups()
+    return float(number) * (2**20 if unit == "MiB" else 2**30)
+
+
+@pytest.mark.parametrize("method", EXACT_METHODS)
+def test_the_estimate_bounds_the_memory_planning_takes(monkeypatch, method):
+    """tracemalloc's peak of a real plan (numpy reports its arrays to it) against the refusal's figure,
+    on A*'s worst case: the goal is walled in, so the search reaches every other pose."""
+    side = 90 if method == "dijkstra" else 50  # A* under tracemalloc is slow; Dijkstra's fixed costs need room
+    occ = np.zeros((side, side), dtype=bool)
+    occ[35:45, 35:45] = True
+    occ[37:43, 37:43] = False  # a room no door leads to
+    ws = Workspace(occ)
+    roadmap = [Pose(2, 2, "O", 0), Pose(39, 40, "O", 0)]
+    plan_exact(Workspace(np.zeros((8, 8), dtype=bool)), [Pose(2, 2, "O", 0), Pose(4, 4, "O", 0)], method=method)
+    tracemalloc.start()
+    try:
+        assert not plan_exact(ws, roadmap, method=method).reached
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    monkeypatch.setattr(SIMULATE, "MEMORY_BUDGET", 2**20)
+    with pytest.raises(PlanningError) as info:
+        plan_exact(ws, roadmap, method=method)
+    needed = _needed_bytes(str(info.value))
+    assert peak <= needed <= 1.6 * peak
+
+
+def test_a_time_expanded_graph_beyond_the_budget_hands_over_to_astar(monkeypatch):
+    occ = np.zeros((10, 10), dtype=bool)
+    moving = (MovingObstacle(np.array([[0, 9]]), np.array([[8, 0]])),)
+    ws = Workspace(occ, moving=moving)
+    roadmap = [Pose(2, 2, "O", 0), Pose(6, 5, "O", 0)]
+    full = plan_exact(ws, roadmap)
+    monkeypatch.setattr(SIMULATE, "MEMORY_BUDGET", 1)
+    with pytest.raises(PlanningError) as info:
+        plan_exact(ws, roadmap, method="astar")
+    monkeypatch.setattr(SIMULATE, "MEMORY_BUDGET", int(_needed_bytes(str(info.value))) + 2**20)
+    handed = plan_exact(ws, roadmap)
+    assert full.method == "dijkstra" and handed.method == "dijkstra (astar)"
+    assert handed.time == pytest.approx(full.time)
