@@ -22,7 +22,7 @@ from htetro_opt import __version__
 from htetro_opt._argparse import Parser, UsageError
 from htetro_opt._console import Console
 from htetro_opt._files import check_output_path, write_text
-from htetro_opt._validation import check_int, check_real, check_seed, check_time_limit
+from htetro_opt._validation import MAX_TIME_LIMIT, check_int, check_real
 from htetro_opt.algorithms import GA_ALGORITHMS
 from htetro_opt.errors import HtetroError, OutputError, ParameterError, PlanningError, ScenarioError
 from htetro_opt.model import Simulator, parse_commands
@@ -226,6 +226,13 @@ def _pose_dict(row) -> dict:
     return {"x": x, "y": y, "shape": STATE_NAMES[s], "heading": h}
 
 
+def _cli_time_limit(value: float | None) -> float | None:
+    """``--time-limit``: absent (the method's default) or a positive, finite number of seconds."""
+    if value is None:
+        return None
+    return check_real(value, "--time-limit (seconds)", minimum=0.0, include_minimum=False, maximum=MAX_TIME_LIMIT)
+
+
 def _check_clearance(value: float) -> float:
     return check_real(value, "--clearance (cells)", minimum=0.0, maximum=10.0, include_maximum=False)
 
@@ -286,7 +293,7 @@ def _cmd_plan(args) -> dict:
                        max_gen=check_int(args.max_gen, "--max-gen", minimum=1),
                        patience=check_int(args.patience, "--patience", minimum=1),
                        max_length=check_int(args.max_length, "--max-length", minimum=1, allow_none=True),
-                       seed=check_seed(args.seed, "--seed"))
+                       seed=check_int(args.seed, "--seed", minimum=0))
     else:
         if given:
             flags = ", ".join("--" + name.replace("_", "-") for name in given)
@@ -414,10 +421,10 @@ def _tileset_of_scenario(name: str, *, shapes, method="backtracking", shuffle=Fa
 
 
 def _cmd_tile(args) -> dict:
-    time_limit = check_time_limit(args.time_limit, "--time-limit")
+    time_limit = _cli_time_limit(args.time_limit)
     if args.seed is not None and not args.shuffle:
         raise ParameterError("--seed applies only with --shuffle (without it the tiling is the same every time)")
-    seed = check_seed(0 if args.seed is None else args.seed, "--seed")
+    seed = check_int(0 if args.seed is None else args.seed, "--seed", minimum=0)
     _outputs(args, ("out", "tileset"), ("plot", "plot"))
     shapes = list(args.shapes) if args.shapes else None
     console = _console(args)
@@ -490,8 +497,8 @@ def _is_scenario(name: str) -> bool:
 
 
 def _cmd_sequence(args) -> dict:
-    time_limit = check_time_limit(args.time_limit, "--time-limit")
-    seed = check_seed(args.seed, "--seed")
+    time_limit = _cli_time_limit(args.time_limit)
+    seed = check_int(args.seed, "--seed", minimum=0)
     _outputs(args, ("plot", "plot"))
     weights = _weights(args.weights)
     if args.start == "free":
@@ -580,7 +587,7 @@ def _cmd_study(args) -> dict:
     else:
         from htetro_opt.studies import seed003
 
-        time_limit = check_time_limit(args.time_limit, "--time-limit")
+        time_limit = _cli_time_limit(args.time_limit)
         with _console(args).step("seed003 study") as progress:
             records = seed003.run_study(seeds=range(args.seeds), time_limit=time_limit,
                                         progress=lambda message: progress(0, None, message))

@@ -121,8 +121,8 @@ def solve_exact(instance: SequencingInstance, *, seed=0, time_limit: float | Non
     n = instance.n
     if n > max_size:
         raise ParameterError(
-            f"the exact sequencer accepts at most max_size={max_size} waypoints, this instance has {n}: "
-            "use the 'ortools' or 'local' method for large instances (or raise max_size and time_limit)"
+            f"the exact method proves optima of at most {max_size} waypoints, this instance has {n}: "
+            "use the ortools or local method for large instances"
         )
     start = instance.start
     if n == 1:

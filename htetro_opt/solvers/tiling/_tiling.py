@@ -611,7 +611,7 @@ def _cpsat_tilings(occ, patterns, seed, deadline, limit):
 def _time_message(method, time_limit) -> str:
     if method == "backtracking":
         return (f"the backtracking search found no tiling within the time limit of {time_limit:g} s; "
-                "try --method cpsat (method='cpsat') or a longer time limit")
+                "try the cpsat method or a longer time limit")
     return f"CP-SAT found no tiling within the time limit of {time_limit:g} s; try a longer time limit"
 
 

@@ -142,7 +142,7 @@ def test_exact_rejects_bad_options():
     with pytest.raises(ParameterError, match="ortools"):
         solve_exact(instance, max_size=5)
     big = SequencingInstance(np.zeros((41, 41)), np.zeros((41, 4, 2), dtype=int), 0)
-    with pytest.raises(ParameterError, match="max_size=40"):
+    with pytest.raises(ParameterError, match="at most 40 waypoints"):
         solve_exact(big)
     for bad in (0, -1.0, math.nan, math.inf, "1", True):
         with pytest.raises(ParameterError, match="time_limit"):
