@@ -12,7 +12,6 @@ the I-shape to the O-shape, as the paper states.
 from __future__ import annotations
 
 import math
-import numbers
 import re
 import reprlib
 from dataclasses import dataclass, fields
@@ -20,7 +19,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from htetro_opt._validation import check_bool, check_real
+from htetro_opt._validation import check_bool, check_int, check_real
 from htetro_opt.errors import ParameterError, UnknownCommandError
 from htetro_opt.model.robot import SHAPES
 
@@ -217,9 +216,11 @@ def format_commands(ids: Iterable[int]) -> list[str]:
         raise ParameterError(f"ids must be a sequence of command ids, got {type(ids).__name__} {reprlib.repr(ids)}")
     tokens = []
     for position, i in enumerate(np.asarray(ids).reshape(-1).tolist() if isinstance(ids, np.ndarray) else ids, start=1):
-        if isinstance(i, bool) or not isinstance(i, numbers.Integral) or not 0 <= i < N_COMMANDS:
+        try:
+            check_int(i, "command id", minimum=0, maximum=N_COMMANDS - 1)
+        except ParameterError:
             raise UnknownCommandError(f"command id {i!r} at position {position} is not a command "
-                                      f"(ids are 0…{N_COMMANDS - 1})")
+                                      f"(ids are 0…{N_COMMANDS - 1})") from None
         tokens.append(TOKENS[int(i)])
     return tokens
 
