@@ -90,6 +90,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
     p.add_argument("--plot", metavar="FILE", help="save a plot of the map and the path (format from the extension)")
+    p.add_argument("--gif", metavar="FILE", help="save an animated GIF of the plan, step by step")
 
     p = sub.add_parser(
         "simulate",
@@ -106,6 +107,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
     p.add_argument("--plot", metavar="FILE", help="save a plot of the map and the executed path")
+    p.add_argument("--gif", metavar="FILE", help="save an animated GIF of the executed commands, step by step")
 
     p = sub.add_parser(
         "tile",
@@ -214,6 +216,14 @@ def _save_plot(console: Console, figure_of, path: str) -> None:
         save_figure(figure_of(), path)
 
 
+def _save_gif(console: Console, workspace, commands, start, *, roadmap, hidden, title: str, path: str) -> None:
+    """Animate the commands from ``start`` and save the GIF, showing progress."""
+    from htetro_opt.viz import animate_path, save_gif
+
+    with console.step(f"animating {path}"):
+        save_gif(animate_path(workspace, commands, start, roadmap=roadmap, hidden=hidden, title=title), path)
+
+
 def _grid_scenario(name: str) -> Scenario:
     scenario = load_scenario(name)
     if not isinstance(scenario, Scenario):
@@ -246,6 +256,8 @@ def _outputs(args, *names: tuple[str, str]) -> None:
         from htetro_opt.viz import figure_format
 
         figure_format(args.plot)
+    if getattr(args, "gif", None) and not str(args.gif).lower().endswith(".gif"):
+        raise ParameterError(f"--gif {args.gif!r}: the animation is a GIF, name the file *.gif")
 
 
 def _cmd_scenarios(args) -> dict:
@@ -278,7 +290,7 @@ def _cmd_scenarios(args) -> dict:
 def _cmd_plan(args) -> dict:
     scenario = _grid_scenario(args.scenario)
     clearance = _check_clearance(args.clearance)
-    _outputs(args, ("plot", "plot"))
+    _outputs(args, ("plot", "plot"), ("gif", "animation"))
     if scenario.goal is None:
         raise PlanningError(f"scenario {scenario.name!r} has no roadmap with a start and a goal to plan for")
     genetic = args.method not in EXACT_METHODS
@@ -331,6 +343,10 @@ def _cmd_plan(args) -> dict:
                 return plot_path(scenario.workspace, plan.poses, roadmap=scenario.roadmap, hidden=scenario.hidden,
                                  title=title)
         _late(out, lambda: _save_plot(console, figure, args.plot))
+    if args.gif:
+        title = f"{scenario.name}: {plan.method}, time {plan.time:g} s"
+        _late(out, lambda: _save_gif(console, scenario.workspace, plan.commands, scenario.roadmap[0],
+                                     roadmap=scenario.roadmap, hidden=scenario.hidden, title=title, path=args.gif))
     if not args.json:
         legs = len(scenario.roadmap) - 1
         failure = "was not solved" if genetic else "has no path"
@@ -379,7 +395,7 @@ def _ga_fields(plan, args) -> dict:
 def _cmd_simulate(args) -> dict:
     scenario = _grid_scenario(args.scenario)
     clearance = _check_clearance(args.clearance)
-    _outputs(args, ("plot", "plot"))
+    _outputs(args, ("plot", "plot"), ("gif", "animation"))
     if scenario.start is None:
         raise PlanningError(f"scenario {scenario.name!r} has no start configuration to simulate from")
     text = _commands_text(args.commands)
@@ -405,6 +421,10 @@ def _cmd_simulate(args) -> dict:
         title = f"{scenario.name}: {out['executed']} of {len(sequence)} commands executed ({state})"
         _late(out, lambda: _save_plot(_console(args), lambda: plot_path(
             world, result.poses(0), roadmap=scenario.roadmap, hidden=scenario.hidden, title=title), args.plot))
+    if args.gif:  # the executed prefix: an invalid command is where the run stopped
+        title = f"{scenario.name}: {out['executed']} of {len(sequence)} commands executed"
+        _late(out, lambda: _save_gif(_console(args), world, result.prefix(0), scenario.start, roadmap=scenario.roadmap,
+                                     hidden=scenario.hidden, title=title, path=args.gif))
     if not args.json:
         f = out["final"]
         print(f"{'valid' if out['valid'] else f'INVALID at command index {first_invalid} (0-based)'}; "

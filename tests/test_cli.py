@@ -851,3 +851,33 @@ def test_cli_errors_speak_the_command_lines_language(capsys, argv):
     assert_one_error_line(code, out, err)
     for library_word in ("or None", "max_size=", "method='", "time_limit ", "Generator"):
         assert library_word not in err, (library_word, err)
+
+
+# --------------------------------------------------------------------------------------------------
+# --gif
+
+
+def test_plan_gif_has_frames_for_every_step(capsys, near, tmp_path):
+    from PIL import Image
+
+    gif = tmp_path / "plan.gif"
+    out = run_json(capsys, ["plan", near, "--json", "--gif", str(gif)])
+    assert gif.read_bytes()[:6] == b"GIF89a"
+    assert Image.open(gif).n_frames == 4 * len(out["commands"]) + 1  # 4 frames a command, the start
+
+
+def test_simulate_gif_shows_the_executed_prefix(capsys, near, tmp_path):
+    from PIL import Image
+
+    gif = tmp_path / "sim.gif"
+    out = run_json(capsys, ["simulate", near, "--commands", "x+ x+ x+ x+ x+ x+", "--json", "--gif", str(gif)])
+    assert out["executed"] == 5 and Image.open(gif).n_frames == 4 * 5 + 1
+
+
+@pytest.mark.parametrize("name,words", [("missing/x.gif", ["cannot write animation", "does not exist"]),
+                                        ("x.png", ["--gif", "GIF"])])
+def test_a_bad_gif_path_is_refused_before_any_work(capsys, near, tmp_path, name, words):
+    folder = tmp_path / "out"
+    folder.mkdir()
+    assert_one_error_line(*run(capsys, ["plan", near, "--gif", str(folder / name)]), *words)
+    assert list(folder.iterdir()) == []

@@ -1,5 +1,6 @@
 """Plotting, kept apart from computing: matplotlib is imported only when a plot is drawn."""
 
+from htetro_opt.viz.animation import MAX_FPS, PathAnimation, animate_path, save_gif
 from htetro_opt.viz.plot import (
     DENSE_CELL_PT,
     SELECTION_STYLES,
@@ -12,4 +13,4 @@ from htetro_opt.viz.plot import (
 from htetro_opt.viz.tiles import plot_coverage, plot_tileset
 
 __all__ = ["SELECTION_STYLES", "SHAPE_COLOURS", "DENSE_CELL_PT", "plot_ga_plan", "plot_path", "save_figure",
-           "figure_format", "plot_coverage", "plot_tileset"]
+           "figure_format", "plot_coverage", "plot_tileset", "animate_path", "save_gif", "PathAnimation", "MAX_FPS"]
