@@ -208,8 +208,16 @@ def _console(args) -> Console:
     return Console(enabled=not getattr(args, "quiet", False) and _stderr_is_terminal())
 
 
+def _files_only_backend() -> None:
+    """The command line only writes files: matplotlib's Agg, never a window (and no display needed)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+
+
 def _save_plot(console: Console, figure_of, path: str) -> None:
     """Draw (``figure_of()``) and save a plot, showing progress: long paths take a while."""
+    _files_only_backend()
     from htetro_opt.viz import save_figure
 
     with console.step(f"plotting {path}"):
@@ -218,6 +226,7 @@ def _save_plot(console: Console, figure_of, path: str) -> None:
 
 def _save_gif(console: Console, workspace, commands, start, *, roadmap, hidden, title: str, path: str) -> None:
     """Animate the commands from ``start`` and save the GIF, showing progress."""
+    _files_only_backend()
     from htetro_opt.viz import animate_path, save_gif
 
     with console.step(f"animating {path}"):

@@ -41,9 +41,8 @@ labels to markers (9 pt is 12.5 pixels at 100 dpi)."""
 
 
 def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
+    # The backend is the caller's choice (a notebook's inline one, a desktop's window); the command
+    # line picks Agg itself. Forcing Agg here would stop a notebook from showing the figures.
     import matplotlib.pyplot as plt
 
     return plt
