@@ -23,7 +23,6 @@ from htetro_opt._argparse import Parser, UsageError
 from htetro_opt._console import Console
 from htetro_opt._files import check_output_path, write_text
 from htetro_opt._validation import MAX_TIME_LIMIT, check_int, check_real
-from htetro_opt.algorithms import GA_ALGORITHMS
 from htetro_opt.errors import HtetroError, OutputError, ParameterError, PlanningError, ScenarioError
 from htetro_opt.model import Simulator, parse_commands
 from htetro_opt.model.commands import DIAGONAL_COMMANDS, SEED000_COMMANDS
@@ -46,8 +45,6 @@ from htetro_opt.solvers.tiling import TILING_METHODS, tile_workspace
 
 __all__ = ["main", "main_entry", "build_parser"]
 
-# The Table-4 study's maps, named here so that building the parser does not import the study.
-_STUDY_ENVIRONMENTS = ("random", "spiral", "h_shape", "three_slit", "perpendicular_dynamic", "parallel_dynamic")
 
 EXIT_ERROR = 2
 GA_DEFAULTS = {"pop_size": 50, "max_gen": 1000, "patience": 100, "max_length": None, "seed": 0}
@@ -156,30 +153,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", metavar="FILE", help="save a plot of the tileset and the order (format from the extension)")
     p = sub.add_parser(
         "study",
-        help="re-run a paper's experiment, our numbers beside the paper's",
-        description="Re-run a paper's experiment on the bundled maps and print our numbers beside the paper's, "
-        "with the exact optimum and every method's gap to it.",
+        help="run a study (scenarios x methods x seeds) and summarise it",
+        description="Run a study: a bundled one by name (small, table4, sequencing) or a study TOML file "
+        "(task, scenarios, seeds, [[methods]] with the command's options), every trial recorded to "
+        "DIR/NAME.jsonl as it ends, then summarised per scenario and method (mean, std, median, success "
+        "rate, gap to the exact reference). 'seed003' re-runs the tables of Le et al. 2018 beside the paper's.",
     )
-    studies = p.add_subparsers(dest="study", required=True, parser_class=Parser)
-    q = studies.add_parser("table4", help="Cheng et al. 2020, Table 4: the hTetro-GA on six maps × three n_pop")
-    q.add_argument("--envs", default=",".join(_STUDY_ENVIRONMENTS),
-                   help=f"comma-separated environments (default all: {','.join(_STUDY_ENVIRONMENTS)})")
-    q.add_argument("--pop-sizes", default="25,50,100", help="comma-separated population sizes (default 25,50,100)")
-    q.add_argument("--seeds", type=int, default=50, help="number of seeds, 0 … N−1 (default 50)")
-    q.add_argument("--max-gen", type=int, default=1000, help="generation cap per leg (default 1000)")
-    q.add_argument("--patience", type=int, default=100,
-                   help="generations without improvement that end a leg (default 100)")
-    q.add_argument("--method", choices=GA_ALGORITHMS, default="htetro-ga", help="the GA (default htetro-ga)")
-    q.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
-    q.add_argument("--out", metavar="DIR", help="write DIR/table4.csv and DIR/table4.md")
-    q.add_argument("--json", action="store_true", help="print one JSON object (the records) instead of the table")
-    q.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
-    q = studies.add_parser("seed003", help="Le et al. 2018, Tables 1–5: tiling and waypoint sequencing")
-    q.add_argument("--seeds", type=int, default=5, help="seeds of the stochastic methods (default 5)")
-    q.add_argument("--time-limit", type=float, help="cap in seconds for each method that takes one")
-    q.add_argument("--out", metavar="DIR", help="write DIR/seed003.md and DIR/seed003.csv")
-    q.add_argument("--json", action="store_true", help="print one JSON object (the records) instead of the report")
-    q.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
+    p.add_argument("study", metavar="NAME|FILE", help="a bundled study name, seed003, or a study TOML file")
+    p.add_argument("--executor", choices=("serial", "processes", "dask"), default="processes",
+                   help="where trials run: this process, local worker processes (default), or a Dask cluster")
+    p.add_argument("--workers", type=int, help="processes / dask: number of workers (default: the local cores)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="dask: join an existing cluster at tcp://HOST:PORT (default: start a local one)")
+    p.add_argument("--seeds", type=int, help="run seeds 0 … N−1 instead of the study's own")
+    p.add_argument("--out", metavar="DIR", help="write DIR/NAME.jsonl (every trial), DIR/NAME.csv and DIR/NAME.md")
+    p.add_argument("--resume", action="store_true", help="skip the trials already recorded in DIR/NAME.jsonl")
+    p.add_argument("--retries", type=int, default=0, help="re-run a failing trial up to N times (default 0)")
+    p.add_argument("--time-limit", type=float, help="seed003 only: cap in seconds for each method that takes one")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of the summary table")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
     return parser
 
 
@@ -592,46 +584,60 @@ def _study_folder(out: str | None) -> Path | None:
 
 
 def _cmd_study(args) -> dict:
-    check_int(args.seeds, "--seeds", minimum=1)
+    if args.study == "seed003":
+        return _legacy_seed003(args)
+    from htetro_opt.studies.runner import load_study, run_study
+
+    if args.time_limit is not None:
+        raise ParameterError("--time-limit applies to seed003 only; a study file sets each method's time_limit")
+    if args.scheduler and args.executor != "dask":
+        raise ParameterError("--scheduler applies only with --executor dask")
+    if args.resume and not args.out:
+        raise ParameterError("--resume needs --out DIR, the folder holding the study's results")
+    study = load_study(args.study)  # the whole file is checked before any trial runs
+    seeds = None if args.seeds is None else check_int(args.seeds, "--seeds", minimum=1)
+    workers = check_int(args.workers, "--workers", minimum=1, allow_none=True)
+    retries = check_int(args.retries, "--retries", minimum=0)
     out = _study_folder(args.out)
-    if args.study == "table4":
-        from htetro_opt.studies import table4
+    console = _console(args)
+    with console.step(f"study {study.name}", 1, "trials") as progress:
+        run = run_study(study, out=out, executor=args.executor, workers=workers, scheduler=args.scheduler,
+                        seeds=seeds, resume=args.resume, retries=retries, progress=progress)
+    if run.dashboard and not args.quiet:
+        print(f"dask dashboard: {run.dashboard}", file=sys.stderr)
+    if not args.json:
+        from htetro_opt.studies.runner import markdown_summary
 
-        envs = [v.strip() for v in args.envs.split(",") if v.strip()]
-        options = dict(max_gen=check_int(args.max_gen, "--max-gen", minimum=1),
-                       patience=check_int(args.patience, "--patience", minimum=1),
-                       method=args.method, jobs=check_int(args.jobs, "--jobs", minimum=1))
-        pop_sizes = [check_int(n, "--pop-sizes", minimum=2) for n in _int_list(args.pop_sizes, "--pop-sizes")]
+        print(markdown_summary(run.summary), end="")
+        if run.path is not None:
+            print(f"\n{len(run.records)} trials ({run.failed} failed) recorded in {run.path}")
+    return run.as_dict()
 
-        console = _console(args)
-        with console.step("table4 trials", 1) as progress:
-            def report(done: int, total: int, record: dict) -> None:
-                progress(done, total, f"last: {record['environment']} n_pop={record['pop_size']} "
-                                      f"seed={record['seed']} {'reached' if record['reached'] else 'not reached'}")
 
-            records = table4.run_study(envs, pop_sizes, range(args.seeds), progress=report, **options)
-        text = table4.markdown_table(table4.summarise(records))
-        files = {"table4.csv": lambda path: table4.write_csv(records, path),
-                 "table4.md": lambda path: write_text(path, text, what="study table")}
-    else:
-        from htetro_opt.studies import seed003
+def _legacy_seed003(args) -> dict:
+    """Le et al. 2018's Tables 1–5 beside the paper's (not on the study runner yet)."""
+    from htetro_opt.studies import seed003
 
-        time_limit = _cli_time_limit(args.time_limit)
-        with _console(args).step("seed003 study") as progress:
-            records = seed003.run_study(seeds=range(args.seeds), time_limit=time_limit,
-                                        progress=lambda message: progress(0, None, message))
-        text = seed003.markdown_report(records) + "\n"
-        files = {"seed003.csv": lambda path: seed003.write_csv(records, path),
-                 "seed003.md": lambda path: write_text(path, text, what="study report")}
-    result = {"study": args.study, "records": records, "out": None if out is None else str(out)}
+    for flag, value in (("--executor", args.executor != "processes"), ("--workers", args.workers),
+                        ("--scheduler", args.scheduler), ("--resume", args.resume), ("--retries", args.retries)):
+        if value:
+            raise ParameterError(f"{flag} does not apply to seed003, which runs in this process")
+    seeds = check_int(5 if args.seeds is None else args.seeds, "--seeds", minimum=1)
+    time_limit = _cli_time_limit(args.time_limit)
+    out = _study_folder(args.out)
+    with _console(args).step("seed003 study") as progress:
+        records = seed003.run_study(seeds=range(seeds), time_limit=time_limit,
+                                    progress=lambda message: progress(0, None, message))
+    text = seed003.markdown_report(records) + "\n"
+    result = {"study": "seed003", "records": records, "out": None if out is None else str(out)}
     if out is not None:
         def write_all() -> None:
             try:
                 out.mkdir(parents=True, exist_ok=True)
             except OSError as err:
                 raise OutputError(f"cannot create the study folder {str(out)!r}: {err.strerror or err}") from err
-            for file_name, write in files.items():
-                write(out / file_name)
+            seed003.write_csv(records, out / "seed003.csv")
+            write_text(out / "seed003.md", text, what="study report")
 
         _late(result, write_all)
     if not args.json:

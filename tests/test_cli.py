@@ -881,3 +881,71 @@ def test_a_bad_gif_path_is_refused_before_any_work(capsys, near, tmp_path, name,
     folder.mkdir()
     assert_one_error_line(*run(capsys, ["plan", near, "--gif", str(folder / name)]), *words)
     assert list(folder.iterdir()) == []
+
+
+# --------------------------------------------------------------------------------------------------
+# study NAME|FILE (the study runner)
+
+TINY_STUDY = """\
+name = "tiny"
+task = "plan"
+scenarios = ["three_slit", "h_shape"]
+seeds = 2
+[[methods]]
+method = "exact"
+[[methods]]
+method = "htetro-ga"
+pop_size = 8
+max_gen = 5
+patience = 3
+"""
+
+
+def test_study_file_runs_records_and_summarises(capsys, tmp_path):
+    study = tmp_path / "tiny.toml"
+    study.write_text(TINY_STUDY)
+    out_dir = tmp_path / "out"
+    code, out, err = run(capsys, ["study", str(study), "--executor", "serial", "--out", str(out_dir)])
+    assert code == 0, err
+    assert "| three_slit | exact |" in out and "| h_shape | htetro-ga |" in out
+    records = [json.loads(line) for line in (out_dir / "tiny.jsonl").read_text().splitlines()]
+    # the exact method runs once per map (no seed), the GA once per seed
+    assert sorted((r["scenario"], r["method"], r["seed"]) for r in records if r.get("kind") != "reference") == [
+        ("h_shape", "dijkstra", None), ("h_shape", "htetro-ga", 0), ("h_shape", "htetro-ga", 1),
+        ("three_slit", "dijkstra", None), ("three_slit", "htetro-ga", 0), ("three_slit", "htetro-ga", 1)]
+    exact = next(r for r in records if r["scenario"] == "three_slit" and r["method"] == "dijkstra")
+    assert exact["time"] == 33.0
+    # resuming a finished study runs nothing again and gives the same summary
+    again = run_json(capsys, ["study", str(study), "--executor", "serial", "--out", str(out_dir), "--resume",
+                              "--json"])
+    assert again["trials"] == 6 and len((out_dir / "tiny.jsonl").read_text().splitlines()) == len(records)
+
+
+@pytest.mark.parametrize("text,words", [
+    (TINY_STUDY.replace('"three_slit"', '"atlantis"'), ["atlantis"]),
+    (TINY_STUDY.replace('method = "exact"', 'method = "simplex"'), ["simplex", "methods[0]"]),
+    (TINY_STUDY.replace("pop_size = 8", "pop_size = 8\ncolour = 3"), ["colour", "methods[1]"]),
+    (TINY_STUDY.replace("pop_size = 8", 'pop_size = "big"'), ["pop_size", "methods[1]"]),
+    (TINY_STUDY.replace('task = "plan"', 'task = "cook"'), ["task", "cook"]),
+    (TINY_STUDY.replace("seeds = 2", "seeds = -2"), ["seeds"]),
+    (TINY_STUDY.replace('method = "exact"', 'method = "exact"\npop_size = 8'), ["pop_size", "methods[0]"]),
+    (TINY_STUDY + "\nfrobnicate = 1\n", ["frobnicate"]),
+    ("name = [\n", ["tiny.toml"]),
+])
+def test_bad_study_files_are_one_error_line_and_write_nothing(capsys, tmp_path, text, words):
+    study = tmp_path / "tiny.toml"
+    study.write_text(text)
+    out_dir = tmp_path / "out"
+    assert_one_error_line(*run(capsys, ["study", str(study), "--out", str(out_dir)]), *words)
+    assert not out_dir.exists()
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["study", "small", "--scheduler", "tcp://127.0.0.1:1"], ["--scheduler", "dask"]),
+    (["study", "small", "--resume"], ["--resume", "--out"]),
+    (["study", "small", "--time-limit", "3"], ["--time-limit", "seed003"]),
+    (["study", "seed003", "--executor", "dask"], ["--executor", "seed003"]),
+    (["study", "nonesuch"], ["nonesuch"]),
+])
+def test_study_options_that_do_not_fit_are_refused(capsys, argv, words):
+    assert_one_error_line(*run(capsys, argv), *words)

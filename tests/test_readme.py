@@ -45,19 +45,12 @@ def _subparsers(parser):
 
 
 def _subcommands():
-    """Command name ("plan", "study table4", …) → its parser."""
-    commands = {}
-    for name, parser in _subparsers(build_parser()).items():
-        if name == "study":
-            commands.update({f"study {study}": p for study, p in _subparsers(parser).items()})
-        else:
-            commands[name] = parser
-    return commands
+    """Command name ("plan", "study", …) → its parser."""
+    return dict(_subparsers(build_parser()))
 
 
 def _command_of(entry: str) -> str:
-    words = entry.split()
-    return " ".join(words[1:3]) if words[1] == "study" else words[1]
+    return entry.split()[1]
 
 
 def _synopsis():

@@ -14,12 +14,14 @@ Our environments are reconstructions (the paper's figures are not in our copy, s
 ``source``), so the generations and times need not match the paper's; the exact optimum is the
 reference that does not depend on the reconstruction.
 
-Run from the command line::
+Run from Python::
 
-    htetro-opt study table4 --seeds 3 --pop-sizes 25,50 --envs three_slit,random \\
-        --max-gen 300 --jobs 2 --out DIR
+    from htetro_opt.studies import table4
+    records = table4.run_study(["three_slit", "random"], [25, 50], range(3), max_gen=300, jobs=2)
+    print(table4.markdown_table(table4.summarise(records)))
 
-which writes ``DIR/table4.csv`` (one line per trial) and ``DIR/table4.md`` and prints the table.
+(``htetro-opt study table4`` runs the same grid on the study runner, :mod:`htetro_opt.studies.runner`,
+with its generic summary.)
 """
 
 from __future__ import annotations

@@ -6,7 +6,6 @@ import re
 
 import pytest
 
-from htetro_opt.cli import main as cli_main
 from htetro_opt.errors import ParameterError
 from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers.grid_paths import plan_exact
@@ -251,38 +250,6 @@ def test_writes_are_atomic(tmp_path, monkeypatch):
         write_csv(_synthetic(), path)
     assert path.read_text() == "old\n"
     assert os.listdir(tmp_path) == ["t.csv"]  # no temporary file left behind
-
-
-# --- command line (htetro-opt study table4) ------------------------------------------------------
-def main(argv):
-    return cli_main(["study", "table4", *argv])
-
-
-def test_main_bad_environment(capsys):
-    assert main(["--envs", "three_slit,atlantis", "--seeds", "1"]) == 2
-    out, err = capsys.readouterr()
-    assert out == ""
-    assert len(err.strip().splitlines()) == 1
-    assert err.startswith("error: ") and "atlantis" in err
-
-
-@pytest.mark.parametrize("argv", [["--pop-sizes", "25,x"], ["--seeds", "0"], ["--jobs", "0"], ["--bogus"],
-                                  ["--method", "pso"], ["--algorithm", "htetro-ga"]])
-def test_main_usage_errors(argv, capsys):
-    assert main(argv) == 2
-    err = capsys.readouterr().err
-    assert len(err.strip().splitlines()) == 1 and err.startswith("error: ")
-
-
-def test_main_writes_files(tmp_path, capsys):
-    out_dir = tmp_path / "out"
-    assert main(["--envs", "three_slit", "--pop-sizes", "12", "--seeds", "1", "--max-gen", "5",
-                 "--out", str(out_dir)]) == 0
-    printed = capsys.readouterr().out
-    assert sorted(os.listdir(out_dir)) == ["table4.csv", "table4.md"]
-    assert (out_dir / "table4.md").read_text() == printed
-    assert "| three_slit | 12 | 1 |" in printed
-    assert read_csv(out_dir / "table4.csv")[0]["exact_time"] == 33.0
 
 
 @pytest.mark.slow

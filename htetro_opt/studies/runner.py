@@ -1,0 +1,1426 @@
+"""Studies at scale: scenarios × methods × seeds, on one machine or a Dask cluster, resumable.
+
+A **study** (:class:`Study`) names a task (the command-line verb it stands for: ``plan``, ``tile``
+or ``sequence``), the scenarios to run it on, the methods with their options, the seeds, and the
+optional metrics to record. It is built in Python or read from a TOML file (:func:`load_study`: a
+bundled name, ``htetro-opt``'s ``studies/data/*.toml``, or a path), which reads like the command
+line it stands for: ``task`` is the verb, each method's keys are that verb's options with
+underscores::
+
+    name = "small"
+    task = "plan"
+    scenarios = ["random", "three_slit", "h_shape"]
+    seeds = 3                     # or a list of seeds
+    [[methods]]
+    method = "dijkstra"
+    [[methods]]
+    method = "htetro-ga"
+    pop_size = 20
+    max_gen = 40
+
+Top-level keys: ``name`` (default: the file's stem; it names the results files), ``description``,
+``task``, ``scenarios`` (bundled names or files; relative paths start from the study file's folder),
+``seeds`` (N for 0 … N−1, or a list), ``metrics`` (optional metrics, :data:`METRICS`) and the
+``[[methods]]``. A method entry holds ``method``, an optional ``label`` (the name of its rows), the
+verb's options, and ``[methods.per_scenario.<scenario>]`` tables of options for one scenario
+(e.g. Table 4's ``max_length = 200`` on the spiral map). The options:
+
+- ``plan``: method ``dijkstra`` (alias ``exact``), ``astar``, ``htetro-ga``, ``htetro-ga-paper``,
+  ``nsga2``, ``nsga3``, ``smsemoa``, ``agemoea``; ``clearance``; ``diagonals`` (the exact methods);
+  ``pop_size``, ``max_gen``, ``patience``, ``max_length`` (the GAs);
+- ``tile``: method ``backtracking`` or ``cpsat``; ``shapes`` (e.g. ``"TZ"``), ``overlap``,
+  ``shuffle`` (then the trials are seeded), ``time_limit`` (default: none);
+- ``sequence``: any sequencing method (``auto``, ``exact``, ``ortools``, ``local``, ``ga``, …);
+  ``start`` (a tile label or ``"free"``), ``weights`` (``[a, b, c, d]`` or ``"a,b,c,d"``),
+  ``time_limit``, ``shapes`` (for scenarios, which are tiled first).
+
+Seeds come from the study, never from a method entry. The whole study is checked before any trial
+runs (:class:`StudyError` names the file, the method entry ``methods[i]``, counted from 0, and the
+key).
+
+A **trial** (:func:`run_trial`) is one method on one scenario with one seed: a pure, module-level
+function whose record is a flat, JSON-ready dict of its inputs, metrics, runtime, solution (the
+commands or order, comma-separated), the package version and ``key``, a hash of its inputs. A method
+whose result does not depend on a seed (the exact planners, a tiling without ``shuffle``, the
+deterministic sequencing methods) runs once per scenario, its record's ``seed`` None. The gap to the
+exact optimum (metric ``"gap"``) comes from one **reference** trial per scenario and run
+(:func:`run_reference`: Dijkstra for ``plan``, the CP-SAT optimum for ``sequence``), recorded in the
+results file like the others.
+
+:func:`run_study` runs the trials ``serial``-ly, on local ``processes`` (the default) or on a
+``dask`` cluster (a local one, or the scheduler at an address), appends one JSON line per trial to
+``DIR/<name>.jsonl`` as each finishes (flushed and synced), skips recorded trials on ``resume``,
+and writes the :func:`summarise` table to ``DIR/<name>.csv`` and ``DIR/<name>.md``. The same study
+and seeds give the same records (:data:`RUNTIME_FIELDS` aside), whatever the executor and however
+often the run was interrupted; a method that stops on a time budget rather than by itself (``ortools``,
+``time_limit`` cut-offs) depends on the machine's speed, as it does on the command line.
+"""
+
+from __future__ import annotations
+
+import csv
+import functools
+import hashlib
+import io
+import json
+import math
+import numbers
+import os
+import re
+import statistics
+import time
+import tomllib
+import uuid
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
+from dataclasses import dataclass, field, replace
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from htetro_opt import __version__
+from htetro_opt._files import write_text
+from htetro_opt._progress import check_progress, report
+from htetro_opt._validation import check_bool, check_int, check_real, check_time_limit
+from htetro_opt.errors import HtetroError, OutputError, ParameterError
+from htetro_opt.studies.metrics import (
+    format_mean_std,
+    group_records,
+    mean_std,
+    values_of,
+)
+
+__all__ = [
+    "EXECUTORS",
+    "METRICS",
+    "RUNTIME_FIELDS",
+    "TASKS",
+    "MethodSpec",
+    "Study",
+    "StudyError",
+    "StudyRun",
+    "markdown_summary",
+    "Trial",
+    "WorkerLost",
+    "list_studies",
+    "load_study",
+    "read_records",
+    "reference_trial",
+    "run_reference",
+    "run_study",
+    "run_trial",
+    "summarise",
+    "write_summary",
+]
+
+TASKS = ("plan", "tile", "sequence")
+"""The tasks a study can run: the command-line verbs of the same names."""
+
+EXECUTORS = ("serial", "processes", "dask")
+"""Where the trials run: in this process, on a local process pool, on a Dask cluster."""
+
+METRICS = {
+    "plan": ("objectives", "generations", "fitness", "gap"),
+    "tile": (),
+    "sequence": ("gap",),
+}
+"""Optional metrics per task, beyond those every record holds (plan: ``reached``, ``time``,
+``n_commands``; tile: ``tiles``, ``overlapping``, ``n_I`` … ``n_T``; sequence: ``cost``,
+``waypoints``):
+
+- ``objectives``: ``translations``, ``rotations``, ``shapeshifts``, ``path_length`` (:meth:`Plan.objectives`);
+- ``generations``: the GAs' ``generations`` (summed over the legs), ``reach_generation`` and
+  ``reach_time_s``;
+- ``fitness``: the GAs' ``f_gr``, ``f_t``, ``f_sm``, ``f_sf`` of the multi-objective solution,
+  averaged over the legs (Cheng et al. 2020's Table 4);
+- ``gap``: ``reference`` (the exact optimum's time or cost) and ``gap`` = (value − reference) /
+  reference; for ``sequence`` only where the optimum is proven (≤ 40 waypoints)."""
+
+RUNTIME_FIELDS = ("runtime_s", "reach_time_s")
+"""Wall-clock fields of a record: the only ones that differ between two runs of the same trial."""
+
+_METRIC_FIELDS = {
+    "plan": ("reached", "time", "n_commands", "translations", "rotations", "shapeshifts", "path_length",
+             "generations", "reach_generation", "reach_time_s", "f_gr", "f_t", "f_sm", "f_sf", "reference", "gap"),
+    "tile": ("tiles", "overlapping", "n_I", "n_O", "n_L", "n_J", "n_Z", "n_S", "n_T"),
+    "sequence": ("cost", "waypoints", "optimal", "reference", "gap"),
+}
+_PLAN_ALIASES = {"exact": "dijkstra"}  # the issue's study files call the minimum-time plan "exact"
+_TOP_KEYS = ("name", "description", "task", "scenarios", "seeds", "metrics", "methods")
+_ENTRY_KEYS = ("method", "label", "per_scenario")
+_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
+
+
+class StudyError(ParameterError):
+    """A study (a TOML file or a :class:`Study` built in Python) is invalid: the message names the
+    file, the method entry (``methods[i]``, counted from 0) and the key."""
+
+
+class WorkerLost(HtetroError, RuntimeError):
+    """A worker process of the ``processes`` executor died (killed, out of memory): the trials
+    recorded so far are kept, and ``resume=True`` continues the study."""
+
+
+# --- options of each task --------------------------------------------------------------------------
+def _plan_methods() -> tuple[tuple[str, ...], tuple[str, ...]]:
+    from htetro_opt.solvers.grid_paths import EXACT_METHODS, PLAN_METHODS
+
+    return tuple(PLAN_METHODS) + tuple(_PLAN_ALIASES), tuple(EXACT_METHODS)
+
+
+def _methods_of(task: str) -> tuple[str, ...]:
+    if task == "plan":
+        return _plan_methods()[0]
+    if task == "tile":
+        from htetro_opt.solvers.tiling import TILING_METHODS
+
+        return tuple(TILING_METHODS)
+    from htetro_opt.solvers.sequencing import SEQUENCE_METHODS
+
+    return tuple(SEQUENCE_METHODS)
+
+
+def _canonical_method(task: str, method: str) -> str:
+    return _PLAN_ALIASES.get(method, method) if task == "plan" else method
+
+
+def _check_clearance(value, name: str) -> float:
+    return check_real(value, name, minimum=0.0, maximum=10.0, include_maximum=False)
+
+
+def _check_shapes(value, name: str) -> str:
+    from htetro_opt.model.robot import SHAPES
+
+    if isinstance(value, (list, tuple)) and all(isinstance(v, str) for v in value):
+        value = "".join(value)
+    if not isinstance(value, str) or not value or any(letter not in SHAPES for letter in value):
+        raise ParameterError(f"{name} must be morphology letters of {''.join(SHAPES)} such as 'TZ', got {value!r}")
+    return value
+
+
+def _check_start(value, name: str) -> int | str:
+    if value == "free":
+        return "free"
+    if isinstance(value, str) and value.strip().isdigit():  # the command line's "--start 1"
+        value = int(value)
+    try:
+        return check_int(value, name, minimum=1)
+    except ParameterError:
+        raise ParameterError(f"{name} must be a tile label (a positive integer) or 'free', got {value!r}") from None
+
+
+def _check_weights(value, name: str) -> list[float]:
+    from htetro_opt.problems import check_weights
+
+    if isinstance(value, str):  # the command line's "--weights 0.4,0.2,0.2,0.2"
+        try:
+            value = [float(v) for v in value.split(",")]
+        except ValueError:
+            raise ParameterError(f"{name} must be four numbers a,b,c,d, got {value!r}") from None
+    if not isinstance(value, (list, tuple)):
+        raise ParameterError(f"{name} must be four numbers (a list, or 'a,b,c,d'), got {value!r}")
+    values = [check_real(v, f"{name}[{i}]", minimum=0.0) for i, v in enumerate(value)]
+    try:
+        return [float(v) for v in check_weights(values)]
+    except ParameterError as err:
+        raise ParameterError(f"{name}: {err}") from None
+
+
+_ALL = None  # an option every method of the task takes
+_OPTIONS: dict[str, dict[str, tuple[Callable, str | None]]] = {
+    # option: (check, which methods take it: None all, "exact" the graph searches, "ga" the others)
+    "plan": {
+        "clearance": (_check_clearance, _ALL),
+        "diagonals": (check_bool, "exact"),
+        "pop_size": (lambda v, n: check_int(v, n, minimum=2), "ga"),
+        "max_gen": (lambda v, n: check_int(v, n, minimum=1), "ga"),
+        "patience": (lambda v, n: check_int(v, n, minimum=1), "ga"),
+        "max_length": (lambda v, n: check_int(v, n, minimum=1), "ga"),
+    },
+    "tile": {
+        "shapes": (_check_shapes, _ALL),
+        "overlap": (check_bool, _ALL),
+        "shuffle": (check_bool, _ALL),
+        "time_limit": (check_time_limit, _ALL),
+    },
+    "sequence": {
+        "start": (_check_start, _ALL),
+        "weights": (_check_weights, _ALL),
+        "time_limit": (check_time_limit, _ALL),
+        "shapes": (_check_shapes, _ALL),
+    },
+}
+_REFERENCE_OPTIONS = {"plan": ("clearance", "diagonals"), "sequence": ("start", "weights", "shapes")}
+
+
+def _takes(task: str, method: str, scope: str | None) -> bool:
+    if scope is None:
+        return True
+    exact = method in _plan_methods()[1]
+    return exact if scope == "exact" else not exact
+
+
+def _seeded(task: str, method: str, parameters: Mapping[str, Any]) -> bool:
+    """Whether the method's result depends on a seed (else the trial runs once, seed None)."""
+    if task == "plan":
+        return method not in _plan_methods()[1]
+    if task == "tile":
+        return bool(parameters.get("shuffle", False))
+    from htetro_opt.studies.seed003 import (
+        STOCHASTIC,  # the sequencing methods that draw random numbers
+    )
+
+    return method in STOCHASTIC
+
+
+# --- scenarios -------------------------------------------------------------------------------------
+def _is_tileset(name: str) -> bool:
+    """``sequence``'s rule, as on the command line: a ``.toml`` file or a bundled scenario is a
+    scenario to tile first; a bundled tileset name or any other file a labelled tileset."""
+    from htetro_opt.scenarios import list_scenarios, list_tilesets
+
+    if name.endswith(".toml"):
+        return False
+    if name in list_tilesets():
+        return True
+    return name not in list_scenarios()
+
+
+def _grid_scenario(name: str):
+    from htetro_opt.errors import ScenarioError
+    from htetro_opt.scenarios import Scenario, load_scenario
+
+    scenario = load_scenario(name)
+    if not isinstance(scenario, Scenario):
+        raise ScenarioError(f"scenario {scenario.name!r} is continuous; this task needs a grid scenario")
+    return scenario
+
+
+def _resolve_scenario(task: str, name, base: Path | None, where: str) -> str:
+    """The scenario's name if bundled, else its path (relative paths from the study file's folder),
+    checked by loading it."""
+    from htetro_opt.scenarios import (
+        list_scenarios,
+        list_tilesets,
+        load_tileset,
+        tileset_path,
+    )
+
+    if not isinstance(name, str) or not name:
+        raise StudyError(f"{where} must be a scenario name or file path, got {name!r}")
+    bundled = list_scenarios() + (list_tilesets() if task == "sequence" else [])
+    resolved = name
+    if "/" in name or name not in bundled:
+        path = Path(name)
+        if base is not None and not path.is_absolute():
+            path = base / path
+        if not path.is_file():
+            kinds = "scenario or tileset" if task == "sequence" else "scenario"
+            raise StudyError(f"{where}: unknown {kinds} {name!r}: not a bundled name ({', '.join(bundled)}) "
+                             "nor a file")
+        resolved = str(path.resolve())
+    try:
+        if task == "sequence" and _is_tileset(resolved):
+            load_tileset(tileset_path(resolved))
+        else:
+            scenario = _grid_scenario(resolved)
+            if task == "plan" and scenario.goal is None:
+                raise StudyError(f"scenario {scenario.name!r} has no roadmap with a start and a goal to plan for")
+    except HtetroError as err:
+        raise StudyError(f"{where} {name!r}: {' '.join(str(err).split())}") from err
+    return resolved
+
+
+# --- the study -------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class MethodSpec:
+    """One method of a study: its canonical name, the label its rows carry, and its options (for
+    every scenario, and per scenario on top of them)."""
+
+    method: str
+    label: str
+    options: Mapping[str, Any] = field(default_factory=dict)
+    per_scenario: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+
+    def parameters(self, scenario: str) -> dict:
+        """The options of a trial on ``scenario``, its own overrides applied, sorted by name."""
+        merged = {**self.options, **self.per_scenario.get(scenario, {})}
+        return {k: merged[k] for k in sorted(merged)}
+
+    def as_entry(self) -> dict:
+        """The study-file entry of this method."""
+        entry = {"method": self.method, "label": self.label, **self.options}
+        if self.per_scenario:
+            entry["per_scenario"] = {k: dict(v) for k, v in self.per_scenario.items()}
+        return entry
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One run: a method with its parameters on a scenario with a seed (None: not seeded).
+
+    ``kind`` is ``"trial"``, or ``"reference"`` for the exact optimum a study's gaps are measured
+    against. :attr:`key` hashes every input, so that a trial is recognised in a results file.
+    """
+
+    task: str
+    scenario: str
+    method: str
+    parameters: Mapping[str, Any]
+    seed: int | None
+    label: str
+    metrics: tuple[str, ...] = ()
+    kind: str = "trial"
+
+    def inputs(self) -> dict:
+        return _inputs(self.kind, self.task, self.scenario, self.method, self.label, self.seed, self.parameters,
+                       self.metrics)
+
+    @property
+    def key(self) -> str:
+        return _key(self.inputs())
+
+    def head(self) -> dict:
+        """The leading fields of this trial's record (its inputs, flattened)."""
+        return _head(self.inputs())
+
+
+@dataclass(frozen=True)
+class Study:
+    """Scenarios × methods × seeds of one task, checked as a whole when made.
+
+    Parameters
+    ----------
+    name : str
+        Names the results files (``<name>.jsonl``, ``.csv``, ``.md``): letters, digits, ``_.-``.
+    task : {"plan", "tile", "sequence"}
+    scenarios : sequence of str
+        Bundled names or files (``sequence``: labelled tilesets too, or scenarios to tile first).
+    methods : sequence of mapping or MethodSpec
+        Each a study-file entry: ``method``, an optional ``label`` (default: the method's name, with
+        its options when several entries share it), the verb's options, and ``per_scenario``
+        (scenario → options overriding them there).
+    seeds : int or sequence of int
+        N for seeds 0 … N−1, or the seeds themselves (default 1). Methods that take no seed run once.
+    metrics : sequence of str
+        Optional metrics of the task (:data:`METRICS`).
+    description : str
+    source : str, optional
+        The study file, named in error messages; relative scenario paths start from its folder.
+
+    Raises
+    ------
+    StudyError
+        Naming the file (or study), the entry and the key of the first mistake.
+
+    Examples
+    --------
+    >>> study = Study(name="demo", task="plan", scenarios=["three_slit"], seeds=2,
+    ...               methods=[{"method": "exact"}, {"method": "htetro-ga", "pop_size": 10}])
+    >>> [(t.label, t.seed) for t in study.trials()]
+    [('exact', None), ('htetro-ga', 0), ('htetro-ga', 1)]
+    >>> Study(name="d", task="plan", scenarios=["three_slit"], methods=[{"method": "astar", "pop_size": 10}])
+    Traceback (most recent call last):
+    ...
+    htetro_opt.studies.runner.StudyError: study 'd', methods[0]: pop_size applies to the GA methods only, not to astar
+    """
+
+    name: str
+    task: str
+    scenarios: tuple[str, ...]
+    methods: tuple[MethodSpec, ...]
+    seeds: tuple[int, ...] = (0,)
+    metrics: tuple[str, ...] = ()
+    description: str = ""
+    source: str | None = field(default=None, compare=False)
+
+    def __post_init__(self) -> None:
+        where = f"study file {self.source!r}" if self.source else f"study {self.name!r}"
+        if not isinstance(self.name, str) or not _NAME.fullmatch(self.name):
+            raise StudyError(f"{where}: name must be letters, digits, '_', '.' or '-' (it names the results "
+                             f"files), got {self.name!r}")
+        if self.task not in TASKS:
+            raise StudyError(f"{where}: task must be one of {', '.join(TASKS)} (a command-line verb), "
+                             f"got {self.task!r}")
+        if not isinstance(self.description, str):
+            raise StudyError(f"{where}: description must be a string, got {self.description!r}")
+        base = Path(self.source).parent if self.source else None
+        scenarios, written = _check_scenarios(self.task, self.scenarios, base, where)
+        seeds = _check_seeds(self.seeds, f"{where}: seeds")
+        metrics = _check_metrics(self.task, self.metrics, where)
+        methods = _check_methods(self.task, self.methods, scenarios, written, where)
+        object.__setattr__(self, "scenarios", scenarios)
+        object.__setattr__(self, "seeds", seeds)
+        object.__setattr__(self, "metrics", metrics)
+        object.__setattr__(self, "methods", methods)
+
+    def with_seeds(self, seeds: int | Sequence[int]) -> Study:
+        """The same study with other seeds (an int N: 0 … N−1)."""
+        return replace(self, seeds=seeds)
+
+    def trials(self) -> list[Trial]:
+        """Every trial, scenario by scenario, method by method, seed by seed."""
+        out = []
+        for scenario in self.scenarios:
+            for spec in self.methods:
+                parameters = spec.parameters(scenario)
+                seeds = self.seeds if _seeded(self.task, spec.method, parameters) else (None,)
+                out.extend(Trial(self.task, scenario, spec.method, parameters, seed, spec.label, self.metrics)
+                           for seed in seeds)
+        return out
+
+    def references(self) -> dict[str, Trial]:
+        """The reference trial (the exact optimum) of each trial that asks for a gap, by trial key."""
+        if "gap" not in self.metrics:
+            return {}
+        return {trial.key: reference_trial(trial) for trial in self.trials()}
+
+
+def reference_trial(trial: Trial) -> Trial:
+    """The exact-optimum trial whose result ``trial``'s gap is measured against: the same scenario
+    with the options that change the optimum (plan: clearance, diagonals; sequence: start, weights,
+    shapes)."""
+    method = "dijkstra" if trial.task == "plan" else "exact"
+    parameters = {k: v for k, v in trial.parameters.items() if k in _REFERENCE_OPTIONS.get(trial.task, ())}
+    if trial.task == "plan" and not _takes("plan", trial.method, "exact"):
+        parameters.pop("diagonals", None)
+    return Trial(trial.task, trial.scenario, method, parameters, None, "reference", (), "reference")
+
+
+def _check_scenarios(task, scenarios, base, where) -> tuple[tuple[str, ...], dict[str, str]]:
+    if isinstance(scenarios, str) or not isinstance(scenarios, Sequence) or not scenarios:
+        raise StudyError(f"{where}: scenarios must be a non-empty list of scenario names or files, got {scenarios!r}")
+    resolved, written = [], {}
+    for i, name in enumerate(scenarios):
+        path = _resolve_scenario(task, name, base, f"{where}: scenarios[{i}]")
+        if path in resolved:
+            raise StudyError(f"{where}: scenarios[{i}] {name!r} is listed twice")
+        resolved.append(path)
+        written[name] = written[path] = path
+    return tuple(resolved), written
+
+
+def _check_seeds(seeds, where: str) -> tuple[int, ...]:
+    if isinstance(seeds, (str, bytes)) or not isinstance(seeds, (numbers.Integral, Sequence)) or \
+            isinstance(seeds, bool) or (isinstance(seeds, Sequence) and not seeds):
+        raise StudyError(f"{where} must be a positive integer N (seeds 0 … N−1) or a non-empty list of seeds, "
+                         f"got {seeds!r}")
+    try:
+        if isinstance(seeds, numbers.Integral):
+            return tuple(range(check_int(seeds, where, minimum=1)))
+        out = tuple(check_int(s, f"{where}[{i}]", minimum=0) for i, s in enumerate(seeds))
+    except ParameterError as err:
+        raise StudyError(str(err)) from err
+    if len(set(out)) < len(out):
+        raise StudyError(f"{where} lists a seed twice: {list(out)}")
+    return out
+
+
+def _check_metrics(task, metrics, where) -> tuple[str, ...]:
+    known = METRICS[task]
+    if isinstance(metrics, str) or not isinstance(metrics, Sequence):
+        raise StudyError(f"{where}: metrics must be a list of names ({', '.join(known) or 'none for ' + task}), "
+                         f"got {metrics!r}")
+    for i, metric in enumerate(metrics):
+        if metric not in known:
+            raise StudyError(f"{where}: metrics[{i}]: unknown metric {metric!r} for task {task}: expected "
+                             f"{', '.join(known) if known else 'none (its records hold every metric)'}")
+    return tuple(m for m in known if m in metrics)
+
+
+def _check_options(task, method, options, scenarios, where) -> dict:
+    """A method's options, each checked; ``scenarios`` the study's scenarios the options apply to."""
+    if not isinstance(options, Mapping):
+        raise StudyError(f"{where} must be a table of options, got {options!r}")
+    known = _OPTIONS[task]
+    out = {}
+    for key, value in options.items():
+        if key == "seed":
+            raise StudyError(f"{where}: seed: the study's `seeds` give every trial its seed; "
+                             "a method entry takes none")
+        if key not in known:
+            raise StudyError(f"{where}: unknown option {key!r} for task {task}: its options are "
+                             f"{', '.join(list(_ENTRY_KEYS) + list(known))}")
+        check, scope = known[key]
+        if not _takes(task, method, scope):
+            which = "the GA methods" if scope == "ga" else "the exact methods (dijkstra, astar)"
+            raise StudyError(f"{where}: {key} applies to {which} only, not to {method}")
+        if task == "sequence" and key == "shapes":
+            tilesets = [s for s in scenarios if _is_tileset(s)]
+            if tilesets:
+                raise StudyError(f"{where}: shapes applies only to scenarios to tile, not to the tileset "
+                                 f"{tilesets[0]!r} (give it under per_scenario)")
+        try:
+            out[key] = check(value, key)
+        except ParameterError as err:
+            raise StudyError(f"{where}: {err}") from err
+    return out
+
+
+def _check_methods(task, methods, scenarios, written, where) -> tuple[MethodSpec, ...]:
+    if isinstance(methods, (str, Mapping)) or not isinstance(methods, Sequence) or not methods:
+        raise StudyError(f"{where}: methods must be a non-empty list of method entries ([[methods]] tables), "
+                         f"got {methods!r}")
+    entries = [m.as_entry() if isinstance(m, MethodSpec) else m for m in methods]
+    specs = []
+    for i, entry in enumerate(entries):
+        here = f"{where}, methods[{i}]"
+        if not isinstance(entry, Mapping):
+            raise StudyError(f"{here} must be a table with a method and its options, got {entry!r}")
+        if "method" not in entry:
+            raise StudyError(f"{here}: method is missing (one of {', '.join(_methods_of(task))})")
+        name = entry["method"]
+        if not isinstance(name, str) or name not in _methods_of(task):
+            raise StudyError(f"{here}: unknown {task} method {name!r}: expected one of {', '.join(_methods_of(task))}")
+        method = _canonical_method(task, name)
+        label = entry.get("label")
+        if label is not None and (not isinstance(label, str) or not label.strip()):
+            raise StudyError(f"{here}: label must be a non-empty string, got {label!r}")
+        options = _check_options(task, method, {k: v for k, v in entry.items() if k not in _ENTRY_KEYS},
+                                 scenarios, here)
+        per_scenario = entry.get("per_scenario", {})
+        if not isinstance(per_scenario, Mapping):
+            raise StudyError(f"{here}: per_scenario must be a table of scenario → options, got {per_scenario!r}")
+        overrides = {}
+        for scenario, scenario_options in per_scenario.items():
+            if scenario not in written:
+                raise StudyError(f"{here}: per_scenario.{scenario}: {scenario!r} is not one of the study's "
+                                 f"scenarios ({', '.join(map(repr, scenarios))})")
+            overrides[written[scenario]] = _check_options(task, method, scenario_options, [written[scenario]],
+                                                          f"{here}, per_scenario.{scenario}")
+        specs.append((name, label, method, options, overrides))
+    names = [name for name, *_ in specs]
+    out, labels = [], {}
+    for i, (name, label, method, options, overrides) in enumerate(specs):
+        if label is None:
+            label = name
+            if names.count(name) > 1 and options:
+                label += " (" + ", ".join(f"{k}={_text(options[k])}" for k in sorted(options)) + ")"
+        if label in labels:
+            raise StudyError(f"{where}, methods[{i}]: label {label!r} is also methods[{labels[label]}]'s: "
+                             "give each entry its own label")
+        labels[label] = i
+        out.append(MethodSpec(method, label, options, overrides))
+    return tuple(out)
+
+
+def _text(value) -> str:
+    if isinstance(value, (list, tuple)):
+        return ",".join(f"{v:g}" if isinstance(v, float) else str(v) for v in value)
+    if isinstance(value, float):
+        return f"{value:g}"
+    return str(value)
+
+
+# --- study files -----------------------------------------------------------------------------------
+def _data_dir() -> Path:
+    return Path(str(resources.files("htetro_opt.studies") / "data"))
+
+
+def list_studies() -> list[str]:
+    """Names of the bundled study files, sorted.
+
+    Examples
+    --------
+    >>> {"small", "table4", "sequencing"} <= set(list_studies())
+    True
+    """
+    return sorted(p.stem for p in _data_dir().glob("*.toml"))
+
+
+def load_study(name_or_path: str | os.PathLike) -> Study:
+    """Read a study: a bundled name (:func:`list_studies`) or a TOML file.
+
+    Top-level keys: ``name`` (default: the file's stem), ``description``, ``task``, ``scenarios``,
+    ``seeds``, ``metrics`` and the ``[[methods]]`` entries, see :class:`Study`.
+
+    Raises
+    ------
+    StudyError
+        If there is no such study, the file is not TOML, or anything in it is invalid (naming the
+        file, the entry and the key).
+
+    Examples
+    --------
+    >>> study = load_study("small")
+    >>> study.task, study.scenarios, [m.label for m in study.methods], len(study.trials())
+    ('plan', ('random', 'three_slit', 'h_shape'), ['dijkstra', 'htetro-ga'], 12)
+    """
+    if not isinstance(name_or_path, (str, os.PathLike)):
+        raise StudyError(f"a study must be a bundled name or a file path, got {name_or_path!r}")
+    bundled = _data_dir() / f"{name_or_path}.toml"
+    if isinstance(name_or_path, str) and "/" not in name_or_path and bundled.is_file():
+        path = bundled
+    else:
+        path = Path(name_or_path)
+        if not path.is_file():
+            raise StudyError(f"no study {str(name_or_path)!r}: not a bundled study ({', '.join(list_studies())}) "
+                             "nor a file")
+    where = f"study file {str(path)!r}"
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError) as err:
+        raise StudyError(f"{where}: cannot read it: {getattr(err, 'strerror', None) or err}") from err
+    except tomllib.TOMLDecodeError as err:
+        raise StudyError(f"{where}: not valid TOML: {err}") from err
+    for key in data:
+        if key not in _TOP_KEYS:
+            raise StudyError(f"{where}: unknown key {key!r}: a study file has {', '.join(_TOP_KEYS)}")
+    for key in ("task", "scenarios", "methods"):
+        if key not in data:
+            raise StudyError(f"{where}: {key} is missing")
+    return Study(name=data.get("name", path.stem), task=data["task"], scenarios=data["scenarios"],
+                 methods=data["methods"], seeds=data.get("seeds", 1), metrics=data.get("metrics", ()),
+                 description=data.get("description", ""), source=str(path))
+
+
+# --- one trial -------------------------------------------------------------------------------------
+def _inputs(kind, task, scenario, method, label, seed, parameters, metrics) -> dict:
+    return {"kind": kind, "task": task, "scenario": scenario, "method": method, "label": label, "seed": seed,
+            "parameters": {k: parameters[k] for k in sorted(parameters)}, "metrics": list(metrics)}
+
+
+def _key(inputs: Mapping[str, Any]) -> str:
+    text = json.dumps(inputs, sort_keys=True, separators=(",", ":"), ensure_ascii=True, allow_nan=False)
+    return hashlib.sha256(text.encode("ascii")).hexdigest()
+
+
+def _head(inputs: Mapping[str, Any]) -> dict:
+    head = {"key": _key(inputs)}
+    head.update({k: inputs[k] for k in ("kind", "task", "scenario", "method", "label", "seed")})
+    head.update(inputs["parameters"])
+    return head
+
+
+def _finite(value):
+    """A JSON-ready scalar: numpy's as Python's, NaN and infinities as None."""
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    value = float(value)
+    return value if math.isfinite(value) else None
+
+
+def _tileset_of(scenario: str, shapes: str | None):
+    from htetro_opt.scenarios import load_tileset, tileset_path
+    from htetro_opt.solvers.tiling import tile_workspace
+
+    if _is_tileset(scenario):
+        return load_tileset(tileset_path(scenario))
+    grid = _grid_scenario(scenario)
+    return tile_workspace(grid.workspace, shapes=list(shapes) if shapes else None, name=grid.name)
+
+
+def _plan(scenario, method, parameters, seed, metrics) -> tuple[dict, dict, float]:
+    from htetro_opt.problems import FITNESS_NAMES
+    from htetro_opt.solvers.grid_paths import plan_path
+
+    grid = _grid_scenario(scenario)
+    options = dict(parameters)
+    if _seeded("plan", method, parameters):
+        options["seed"] = seed
+    plan = plan_path(grid.workspace, grid.roadmap, method=method, **options)
+    reached = bool(plan.reached)
+    out = {"reached": reached, "time": float(plan.time) if reached else None,
+           "n_commands": len(plan.commands) if reached else None}
+    if "objectives" in metrics:
+        objectives = plan.objectives()
+        out.update({k: objectives[k] if reached else None
+                    for k in ("translations", "rotations", "shapeshifts", "path_length")})
+    legs = plan.legs
+    if "generations" in metrics:
+        out["generations"] = sum(leg.generations for leg in legs) if legs else None
+        out["reach_generation"] = plan.reach_generation
+        out["reach_time_s"] = sum(leg.reach_time_s for leg in legs) if legs and reached else None
+    if "fitness" in metrics:
+        fitness = [leg.selected["multi_objective"].fitness for leg in legs]
+        out.update({name: sum(float(f[i]) for f in fitness) / len(fitness) if fitness else None
+                    for i, name in enumerate(FITNESS_NAMES)})
+    return out, {"commands": ",".join(plan.tokens)}, plan.runtime_s
+
+
+def _tile(scenario, method, parameters, seed) -> tuple[dict, dict, float]:
+    from htetro_opt.model.robot import SHAPES
+    from htetro_opt.scenarios import format_tileset
+    from htetro_opt.solvers.tiling import tile_workspace
+
+    grid = _grid_scenario(scenario)
+    shapes = parameters.get("shapes")
+    began = time.perf_counter()
+    tileset = tile_workspace(grid.workspace, method=method, shapes=list(shapes) if shapes else None,
+                             shuffle=parameters.get("shuffle", False), seed=seed,
+                             time_limit=parameters.get("time_limit"), overlap=parameters.get("overlap", False),
+                             name=grid.name)
+    runtime = time.perf_counter() - began
+    kinds = tileset.shapes
+    out = {"tiles": len(tileset), "overlapping": tileset.overlapping, **{f"n_{s}": kinds.count(s) for s in SHAPES}}
+    rows = (" ".join(row.split()) for row in format_tileset(tileset).split("\n"))
+    return out, {"tileset": ";".join(rows)}, runtime
+
+
+def _instance(scenario, parameters):
+    from htetro_opt.problems import DEFAULT_BLOCK_WEIGHTS, SequencingInstance
+
+    tileset = _tileset_of(scenario, parameters.get("shapes"))
+    start = parameters.get("start", 1)
+    return SequencingInstance.from_tileset(tileset, start=None if start == "free" else start,
+                                           weights=parameters.get("weights", DEFAULT_BLOCK_WEIGHTS))
+
+
+def _sequence(scenario, method, parameters, seed) -> tuple[dict, dict, float]:
+    from htetro_opt.solvers.sequencing import sequence_waypoints
+
+    instance = _instance(scenario, parameters)
+    options = {} if seed is None else {"seed": seed}
+    result = sequence_waypoints(instance, method=method, time_limit=parameters.get("time_limit"), **options)
+    out = {"cost": float(result.cost), "waypoints": instance.n}
+    return out, {"order": ",".join(str(t) for t in result.tiles)}, result.runtime_s
+
+
+def _record(head: dict, metrics: Mapping[str, Any], solution: Mapping[str, Any], runtime_s: float | None,
+            error: str | None = None) -> dict:
+    record = dict(head)
+    record.update({k: _finite(v) for k, v in metrics.items()})
+    record.update(solution)
+    record["runtime_s"] = _finite(runtime_s)
+    record["error"] = error
+    record["version"] = __version__
+    return record
+
+
+def _check_trial_inputs(task, scenario, parameters) -> None:
+    if task not in TASKS:
+        raise ParameterError(f"task must be one of {', '.join(TASKS)}, got {task!r}")
+    if not isinstance(scenario, str):
+        raise ParameterError(f"scenario must be a bundled name or a file path (str), got {scenario!r}")
+    if not isinstance(parameters, Mapping):
+        raise ParameterError(f"parameters must be a mapping of option names to values, got {parameters!r}")
+
+
+def run_trial(task: str, scenario: str, method: str, parameters: Mapping[str, Any], seed: int | None, *,
+              label: str | None = None, metrics: Sequence[str] = ()) -> dict:
+    """Run one trial and return its record: a flat, JSON-ready dict.
+
+    Parameters
+    ----------
+    task : {"plan", "tile", "sequence"}
+    scenario : str
+        A bundled name or a file (``sequence``: a labelled tileset, or a scenario tiled first).
+    method : str
+        A method of the task's command-line verb (``plan`` also takes ``exact`` for ``dijkstra``).
+    parameters : mapping
+        The verb's options, as a study's method entry gives them (``plan``: clearance, diagonals,
+        pop_size, max_gen, patience, max_length; ``tile``: shapes, overlap, shuffle, time_limit;
+        ``sequence``: start, weights, time_limit, shapes).
+    seed : int or None
+        The seed of a seeded method (None for the others, which run with their default).
+    label : str, keyword-only
+        The name the trial's rows carry (default: ``method``).
+    metrics : sequence of str, keyword-only
+        Optional metrics (:data:`METRICS`); ``"gap"`` is added by :func:`run_study` from the
+        reference trial (:func:`run_reference`), not here.
+
+    Returns
+    -------
+    dict
+        ``key`` (sha256 of the inputs), ``kind``, ``task``, ``scenario``, ``method``, ``label``,
+        ``seed``, the parameters, the metrics, the solution (plan: ``commands``; tile: ``tileset``,
+        the labelled rows top-down joined by ``;``; sequence: ``order``, tile labels), ``runtime_s``
+        (the solver's), ``error`` (None) and ``version``.
+
+    Raises
+    ------
+    HtetroError
+        Whatever the solver raises on this scenario (:func:`run_study` records it as the trial's error).
+
+    Examples
+    --------
+    >>> record = run_trial("plan", "three_slit", "dijkstra", {}, None)
+    >>> record["reached"], record["time"], record["commands"].split(",")[:3]
+    (True, 33.0, ['x+', 'x+', 'x+'])
+    """
+    _check_trial_inputs(task, scenario, parameters)
+    if not isinstance(method, str):
+        raise ParameterError(f"method must be a method name, got {method!r}")
+    if label is not None and not isinstance(label, str):
+        raise ParameterError(f"label must be a string or None, got {label!r}")
+    method = _canonical_method(task, method)
+    try:
+        metrics = _check_metrics(task, metrics, "run_trial")
+    except StudyError as err:
+        raise ParameterError(str(err)) from None
+    head = _head(_inputs("trial", task, scenario, method, method if label is None else label, seed, parameters,
+                         metrics))
+    if task == "plan":
+        values, solution, runtime = _plan(scenario, method, parameters, seed, metrics)
+    elif task == "tile":
+        values, solution, runtime = _tile(scenario, method, parameters, seed)
+    else:
+        values, solution, runtime = _sequence(scenario, method, parameters, seed)
+    return _record(head, values, solution, runtime)
+
+
+def run_reference(task: str, scenario: str, parameters: Mapping[str, Any]) -> dict:
+    """The exact optimum a study's gaps are measured against, as a record (``kind`` "reference").
+
+    ``plan``: Dijkstra's minimum-time plan (``reached``, ``time``, ``n_commands``, ``commands``);
+    ``sequence``: the CP-SAT optimum (``cost``, ``waypoints``, ``optimal``, ``order``), ``cost``
+    None beyond :data:`~htetro_opt.solvers.sequencing.EXACT_AUTO_LIMIT` waypoints, where no optimum
+    is proven.
+
+    Examples
+    --------
+    >>> record = run_reference("sequence", "paper_6x6_fig13a", {})
+    >>> round(record["cost"], 6), record["optimal"], record["order"]
+    (17.190762, True, '1,2,3,4,9,7,6,8,5')
+    """
+    _check_trial_inputs(task, scenario, parameters)
+    if task not in _REFERENCE_OPTIONS:
+        raise ParameterError(f"task {task!r} has no exact reference (plan and sequence have)")
+    trial = reference_trial(Trial(task, scenario, "dijkstra" if task == "plan" else "exact", parameters, None,
+                                  "reference"))
+    if task == "plan":
+        values, solution, runtime = _plan(scenario, trial.method, trial.parameters, None, ())
+        return _record(trial.head(), values, solution, runtime)
+    from htetro_opt.solvers.sequencing import EXACT_AUTO_LIMIT, sequence_waypoints
+
+    instance = _instance(scenario, trial.parameters)
+    if instance.n > EXACT_AUTO_LIMIT:
+        return _record(trial.head(), {"cost": None, "waypoints": instance.n, "optimal": False}, {"order": None}, None)
+    result = sequence_waypoints(instance, method="exact")
+    values = {"cost": float(result.cost), "waypoints": instance.n, "optimal": bool(result.info.get("optimal"))}
+    return _record(trial.head(), values, {"order": ",".join(str(t) for t in result.tiles)}, result.runtime_s)
+
+
+def _with_gap(record: dict, reference: Mapping[str, Any] | None) -> dict:
+    """``record`` with ``reference`` and ``gap`` (relative, to the exact optimum) after its metrics."""
+    if record.get("error") is not None:
+        return record
+    if record["task"] == "plan":
+        value = record.get("time")
+        best = reference.get("time") if reference and reference.get("reached") else None
+    else:
+        value = record.get("cost")
+        best = reference.get("cost") if reference and reference.get("optimal") else None
+    gap = None
+    if value is not None and best is not None:
+        gap = (value - best) / best if best > 0 else (0.0 if value == best else None)
+    out = {}
+    for k, v in record.items():
+        if k == "runtime_s":
+            out["reference"], out["gap"] = best, _finite(gap)
+        out[k] = v
+    return out
+
+
+# --- executors -------------------------------------------------------------------------------------
+def _attempts(function: Callable, args: tuple, retries: int) -> tuple[str, Any]:
+    """Run ``function(*args)`` up to ``retries + 1`` times: ("ok", record) or ("error", "Type: message").
+
+    Errors travel as text: an exception of a user's trial function need not pickle."""
+    for _ in range(retries + 1):
+        try:
+            return "ok", function(*args)
+        except Exception as err:  # noqa: BLE001 -- any failure of a trial is its result, recorded
+            error = _error_text(err)
+    return "error", error
+
+
+def _error_text(err: BaseException) -> str:
+    return f"{type(err).__name__}: {' '.join(str(err).split())}"
+
+
+Call = tuple[Trial, Callable]
+
+
+def _serial(calls: Sequence[Call], retries: int) -> Iterator[tuple[Trial, tuple[str, Any]]]:
+    for trial, function in calls:
+        yield trial, _attempts(function, (), retries)
+
+
+def _processes(calls: Sequence[Call], retries: int, workers: int | None) -> Iterator[tuple[Trial, tuple[str, Any]]]:
+    pool = ProcessPoolExecutor(max_workers=min(workers or os.cpu_count() or 1, len(calls)))
+    finished = False
+    try:
+        futures = {pool.submit(_attempts, function, (), retries): trial for trial, function in calls}
+        for future in as_completed(futures):
+            trial = futures.pop(future)
+            try:
+                outcome = future.result()
+            except BrokenProcessPool as err:
+                raise WorkerLost(f"a worker process died while running {trial.scenario} {trial.label} "
+                                 f"seed {trial.seed} ({err}); the trials recorded so far are kept: "
+                                 "resume continues the study") from err
+            yield trial, outcome
+        finished = True
+    finally:
+        pool.shutdown(wait=finished, cancel_futures=True)
+
+
+@contextmanager
+def _dask_client(scheduler, workers: int | None):
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError as err:
+        raise ParameterError("executor 'dask' needs dask.distributed: pip install 'htetro-opt[dask]'") from err
+    if isinstance(scheduler, Client):  # the caller's: theirs to close
+        yield scheduler
+        return
+    import logging
+
+    cluster = None
+    try:
+        if scheduler is None:
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, dashboard_address=":0",
+                                   silence_logs=logging.ERROR)
+            client = Client(cluster)
+        else:
+            client = Client(scheduler, timeout="10s")
+    except (OSError, TimeoutError) as err:
+        if cluster is not None:
+            cluster.close()
+        where = "a local Dask cluster" if scheduler is None else f"the Dask scheduler {scheduler!r}"
+        raise ParameterError(f"cannot connect to {where}: {err}") from err
+    try:
+        yield client
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _dask(calls: Sequence[Call], retries: int, client) -> Iterator[tuple[Trial, tuple[str, Any]]]:
+    from distributed import as_completed as dask_completed
+
+    futures = {}
+    run = uuid.uuid4().hex[:8]  # a key of this run's own: an earlier run's failed task may linger on the cluster
+    for trial, function in calls:
+        # references first: the gaps of the trials wait for them
+        future = client.submit(function, key=f"{trial.kind}-{trial.key[:16]}-{run}", retries=retries,
+                               priority=1 if trial.kind == "reference" else 0)
+        futures[future] = trial
+    try:
+        for future in dask_completed(list(futures)):
+            trial = futures.pop(future)
+            if future.status == "finished":
+                outcome = ("ok", future.result())
+            else:
+                error = future.exception() if future.status == "error" else None
+                outcome = ("error", _error_text(error) if error is not None else f"Cancelled: {future.status}")
+            future.release()
+            yield trial, outcome
+    finally:
+        for future in futures:
+            future.cancel()
+
+
+def _dashboard(client) -> str | None:
+    try:
+        return client.dashboard_link
+    except (KeyError, AttributeError):  # a scheduler started without its dashboard
+        return None
+
+
+# --- results files ---------------------------------------------------------------------------------
+def read_records(path: str | os.PathLike, *, repair: bool = False) -> list[dict]:
+    """The records of a results file (JSON Lines), in file order.
+
+    A last line without its newline was torn by a process killed while writing it: it is left out,
+    and with ``repair`` cut from the file.
+
+    Raises
+    ------
+    StudyError
+        If a complete line is not a record (naming the file and the line).
+    OSError
+        If the file cannot be read.
+    """
+    if not isinstance(path, (str, os.PathLike)):
+        raise ParameterError(f"path must be a results file path, got {path!r}")
+    path = Path(path)
+    data = path.read_bytes()
+    lines = data.split(b"\n")
+    torn = lines.pop()
+    records = []
+    for number, line in enumerate(lines, start=1):
+        try:
+            record = json.loads(line)
+        except ValueError:
+            record = None
+        if not isinstance(record, dict) or not isinstance(record.get("key"), str):
+            raise StudyError(f"results file {str(path)!r}, line {number}: not a trial record "
+                             f"({line[:60].decode('utf-8', 'replace')!r}…)")
+        records.append(record)
+    if torn and repair:
+        with open(path, "r+b") as handle:
+            handle.truncate(len(data) - len(torn))
+            handle.flush()
+            os.fsync(handle.fileno())
+    return records
+
+
+@contextmanager
+def _appender(path: Path | None) -> Iterator[Callable[[Mapping[str, Any]], None]]:
+    """A function appending one JSON line per record, flushed and synced, so that a kill loses at
+    most the line being written (dropped by the next resume); None: records are not kept."""
+    if path is None:
+        yield lambda record: None
+        return
+    try:
+        handle = open(path, "a", encoding="utf-8")  # noqa: SIM115 -- open for the whole run
+    except OSError as err:
+        raise OutputError(f"cannot write results file {str(path)!r}: {err.strerror or err}") from err
+
+    def append(record: Mapping[str, Any]) -> None:
+        handle.write(json.dumps(record, ensure_ascii=False, separators=(",", ":"), allow_nan=False) + "\n")
+        handle.flush()
+        os.fsync(handle.fileno())
+
+    with handle:
+        yield append
+
+
+def _folder(out) -> Path | None:
+    if out is None:
+        return None
+    if not isinstance(out, (str, os.PathLike)):
+        raise ParameterError(f"out must be a folder path or None, got {out!r}")
+    folder = Path(out)
+    if folder.exists() and not folder.is_dir():
+        raise OutputError(f"cannot write the study's results in {str(folder)!r}: it is a file, not a folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise OutputError(f"cannot create the results folder {str(folder)!r}: {err.strerror or err}") from err
+    return folder
+
+
+# --- running a study -------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class StudyRun:
+    """What :func:`run_study` did: the study's records (in trial order, resumed ones included), its
+    summary, the results file, the Dask dashboard, and counts."""
+
+    study: Study
+    records: list[dict]
+    references: list[dict]
+    summary: list[dict]
+    path: Path | None
+    dashboard: str | None = None
+    resumed: int = 0
+    failed: int = 0
+
+    def as_dict(self) -> dict:
+        """JSON-ready (for ``--json``)."""
+        return {"study": self.study.name, "task": self.study.task,
+                "path": None if self.path is None else str(self.path), "dashboard": self.dashboard,
+                "trials": len(self.records), "resumed": self.resumed, "failed": self.failed,
+                "summary": self.summary, "records": self.records, "references": self.references}
+
+
+def _is_client(value) -> bool:
+    try:
+        from distributed import Client
+    except ImportError:
+        return False
+    return isinstance(value, Client)
+
+
+def _check_run_options(executor, workers, scheduler, retries, resume, out) -> None:
+    if executor not in EXECUTORS:
+        raise ParameterError(f"executor must be one of {', '.join(EXECUTORS)}, got {executor!r}")
+    check_int(workers, "workers", minimum=1, allow_none=True)
+    check_int(retries, "retries", minimum=0)
+    check_bool(resume, "resume")
+    if workers is not None and executor == "serial":
+        raise ParameterError("workers applies to the processes and dask executors, not to serial")
+    if scheduler is not None:
+        if executor != "dask":
+            raise ParameterError(f"scheduler applies to the dask executor only, not to {executor}")
+        if workers is not None:
+            raise ParameterError("workers applies to a local Dask cluster, not to one joined at a scheduler address")
+        if not isinstance(scheduler, str) and not _is_client(scheduler):
+            raise ParameterError(f"scheduler must be an address such as 'tcp://127.0.0.1:8786' or a "
+                                 f"distributed.Client, got {scheduler!r}")
+    if resume and out is None:
+        raise ParameterError("resume needs out, the folder of the results file to resume")
+
+
+def run_study(study: Study | str | os.PathLike, *, out: str | os.PathLike | None = None,
+              executor: str = "processes", workers: int | None = None, scheduler=None,
+              seeds: int | Sequence[int] | None = None, resume: bool = False, retries: int = 0,
+              progress=None, trial: Callable | None = None) -> StudyRun:
+    """Run every trial of a study, recording each as it finishes.
+
+    Parameters
+    ----------
+    study : Study, or str or path
+        A study, or a bundled study's name or a study file (:func:`load_study`).
+    out : str or path, optional, keyword-only
+        Folder of the results (created if missing): ``<name>.jsonl``, one line per trial, and the
+        summary ``<name>.csv`` and ``<name>.md`` at the end. None: records are only returned.
+    executor : {"serial", "processes", "dask"}, keyword-only
+        ``processes`` (default): a local process pool; ``dask``: a ``distributed`` cluster.
+    workers : int, optional, keyword-only
+        Processes of the pool, or workers of a local Dask cluster (default: the machine's cores).
+    scheduler : str or distributed.Client, optional, keyword-only
+        ``dask`` only: join the cluster of this scheduler address (``"tcp://HOST:PORT"``), or run
+        on this client. Default: start a local cluster for the run.
+    seeds : int or sequence of int, optional, keyword-only
+        Override the study's seeds (N: 0 … N−1).
+    resume : bool, keyword-only
+        Keep the trials already recorded in ``out``'s results file and run the others. Without it,
+        a results file that holds records is an error (rather than overwritten).
+    retries : int, keyword-only
+        Re-run a trial that raised up to this many times before recording its error.
+    progress : callable, optional, keyword-only
+        ``progress(done, total, note)`` after each trial (:mod:`htetro_opt._progress`); the note
+        names the last trial and counts the failures so far (and the Dask dashboard at the start).
+    trial : callable, optional, keyword-only
+        A module-level function with :func:`run_trial`'s signature to run instead (benchmarks,
+        tests); the references stay :func:`run_reference`.
+
+    Returns
+    -------
+    StudyRun
+
+    Raises
+    ------
+    StudyError, ParameterError
+        On an invalid study or option, before any trial runs and before any file is written.
+    OutputError
+        If the results cannot be written, or ``out`` already holds this study's results and
+        ``resume`` is off.
+    WorkerLost
+        If a worker process of the pool died; the records so far are kept.
+
+    Examples
+    --------
+    >>> study = Study(name="demo", task="plan", scenarios=["three_slit"], methods=[{"method": "dijkstra"}])
+    >>> run = run_study(study, executor="serial")
+    >>> [(r["label"], r["reached"], r["time"]) for r in run.records]
+    [('dijkstra', True, 33.0)]
+    >>> run.summary[0]["success_rate"], run.summary[0]["time_mean"]
+    (1.0, 33.0)
+    """
+    study = study if isinstance(study, Study) else load_study(study)
+    if seeds is not None:
+        study = study.with_seeds(seeds)
+    _check_run_options(executor, workers, scheduler, retries, resume, out)
+    progress = check_progress(progress)
+    if trial is not None and not callable(trial):
+        raise ParameterError(f"trial must be a function like run_trial, got {trial!r}")
+    function = run_trial if trial is None else trial
+
+    trials = study.trials()
+    references_of = study.references()
+    references = list({ref.key: ref for ref in references_of.values()}.values())
+    folder = _folder(out)
+    path = None if folder is None else folder / f"{study.name}.jsonl"
+    recorded: dict[str, dict] = {}
+    if path is not None and path.exists():
+        existing = read_records(path, repair=resume)
+        if existing and not resume:
+            raise OutputError(f"results file {str(path)!r} already holds {len(existing)} records: resume continues "
+                              "the study; remove the file to start it over")
+        for record in existing:
+            recorded.setdefault(record["key"], record)
+
+    wanted = {t.key for t in trials} | {r.key for r in references}
+    resumed = sum(key in recorded for key in wanted)
+    todo = [r for r in references if r.key not in recorded] + [t for t in trials if t.key not in recorded]
+    calls = [(t, _bind(t, function)) for t in todo]
+    total, done = len(wanted), resumed
+    failed = sum(recorded[k].get("error") is not None for k in wanted if k in recorded)
+    waiting: dict[str, list[dict]] = {}  # reference key -> trial records waiting for it
+
+    def finish(record: dict) -> None:
+        nonlocal done, failed
+        append(record)
+        recorded[record["key"]] = record
+        done += 1
+        failed += record.get("error") is not None
+        note = f"{record['scenario']} {record['label']}" + ("" if record["seed"] is None else f" seed {record['seed']}")
+        report(progress, done, total, f"{note}; {failed} failed")
+
+    report(progress, done, total, f"{resumed} recorded before" if resumed else "")
+    runner = _outcomes(calls, executor, workers, scheduler, retries)
+    with _appender(path) as append, runner as (outcomes, dashboard):
+        if dashboard:
+            report(progress, done, total, f"Dask dashboard: {dashboard}")
+        for item, (status, value) in outcomes:
+            record = value if status == "ok" else _record(item.head(), {}, {}, None, value)
+            if item.kind == "reference":
+                finish(record)
+                for pending in waiting.pop(item.key, []):
+                    finish(_with_gap(pending, record))
+                continue
+            if item.key in references_of:
+                reference = references_of[item.key].key
+                if reference not in recorded:
+                    waiting.setdefault(reference, []).append(record)
+                    continue
+                record = _with_gap(record, recorded[reference])
+            finish(record)
+
+    records = [recorded[t.key] for t in trials]
+    summary = summarise(records)
+    if folder is not None:
+        write_summary(summary, folder, name=study.name)
+    return StudyRun(study, records, [recorded[r.key] for r in references], summary, path, dashboard,
+                    resumed, failed)
+
+
+def _bind(trial: Trial, function: Callable) -> Callable:
+    """The call of one trial, picklable (a partial of a module-level function)."""
+    if trial.kind == "reference":
+        return functools.partial(run_reference, trial.task, trial.scenario, trial.parameters)
+    return functools.partial(function, trial.task, trial.scenario, trial.method, trial.parameters, trial.seed,
+                             label=trial.label, metrics=trial.metrics)
+
+
+@contextmanager
+def _outcomes(calls, executor, workers, scheduler, retries):
+    """(iterator of (trial, outcome) in completion order, the Dask dashboard or None)."""
+    if not calls:
+        yield iter(()), None
+    elif executor == "serial":
+        yield _serial(calls, retries), None
+    elif executor == "processes":
+        outcomes = _processes(calls, retries, workers)
+        try:
+            yield outcomes, None
+        finally:
+            outcomes.close()
+    else:
+        with _dask_client(scheduler, workers) as client:
+            outcomes = _dask(calls, retries, client)
+            try:
+                yield outcomes, _dashboard(client)
+            finally:
+                outcomes.close()
+
+
+# --- summaries -------------------------------------------------------------------------------------
+def _success(record: Mapping[str, Any]) -> bool:
+    return record.get("error") is None and record.get("reached") is not False
+
+
+def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict]:
+    """One row per scenario × method (label) of trial records (references left out), in order of
+    first appearance.
+
+    Each row holds ``task``, ``scenario``, ``label``, ``method``, ``runs``, ``errors``,
+    ``successes`` (no error, and the goal reached where the task has one) and ``success_rate``,
+    ``reference`` (the exact optimum, where the study measured gaps), and for each numeric metric
+    present in the records (``runtime_s`` included) ``<metric>_mean``, ``<metric>_std`` (sample
+    standard deviation, None for one value) and ``<metric>_median``, over the runs that measured it.
+
+    Examples
+    --------
+    >>> rows = summarise([
+    ...     {"task": "plan", "scenario": "a", "label": "ga", "method": "htetro-ga", "reached": True, "time": 30.0},
+    ...     {"task": "plan", "scenario": "a", "label": "ga", "method": "htetro-ga", "reached": False, "time": None},
+    ...     {"task": "plan", "scenario": "a", "label": "ga", "method": "htetro-ga", "error": "TilingError: no"},
+    ... ])
+    >>> rows[0]["runs"], rows[0]["errors"], rows[0]["success_rate"], rows[0]["time_mean"], rows[0]["time_median"]
+    (3, 1, 0.3333333333333333, 30.0, 30.0)
+    """
+    records = _check_rows(records, "records")
+    records = [r for r in records if r.get("kind", "trial") != "reference"]
+    fields = [k for task in TASKS if any(r.get("task") == task for r in records) for k in _METRIC_FIELDS[task]]
+    numeric = [k for k in dict.fromkeys(fields + ["runtime_s"])
+               if k != "reference" and any(_is_number(r.get(k)) for r in records)]
+    rows = []
+    for (task, scenario, label), group in group_records(records, ["task", "scenario", "label"]).items():
+        successes = sum(_success(r) for r in group)
+        references = [r["reference"] for r in group if r.get("reference") is not None]
+        row: dict[str, Any] = {
+            "task": task, "scenario": scenario, "label": label, "method": group[0].get("method"),
+            "runs": len(group), "errors": sum(r.get("error") is not None for r in group),
+            "successes": successes, "success_rate": successes / len(group),
+            "reference": references[0] if references else None,
+        }
+        for name in numeric:
+            values = values_of(group, name)
+            row[f"{name}_mean"], row[f"{name}_std"] = mean_std(values)
+            row[f"{name}_median"] = float(statistics.median(values)) if values else None
+        rows.append(row)
+    return rows
+
+
+def _check_rows(rows, name: str) -> list:
+    if isinstance(rows, (str, bytes, Mapping)) or not isinstance(rows, Iterable):
+        raise ParameterError(f"{name} must be an iterable of records (dicts), got {rows!r}")
+    rows = list(rows)
+    for i, row in enumerate(rows):
+        if not isinstance(row, Mapping):
+            raise ParameterError(f"{name}[{i}] must be a record (a dict), got {row!r}")
+    return rows
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def _cell(value) -> str:
+    if value is None:
+        return ""
+    return repr(float(value)) if isinstance(value, float) else str(value)
+
+
+def _summary_csv(summary: Sequence[Mapping[str, Any]]) -> str:
+    fields: list[str] = []
+    for row in summary:
+        fields += [k for k in row if k not in fields]
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(fields)
+    for row in summary:
+        writer.writerow([_cell(row.get(k)) for k in fields])
+    return buffer.getvalue()
+
+
+def markdown_summary(summary: Sequence[Mapping[str, Any]]) -> str:
+    metrics = []
+    for row in summary:
+        metrics += [k[:-5] for k in row if k.endswith("_mean") and k[:-5] not in metrics]
+    metrics = [m for m in metrics if any(row.get(f"{m}_mean") is not None for row in summary)]
+    header = ["scenario", "method", "runs", "success", "reference"] + [f"{m} mean ± std (median)" for m in metrics]
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join(["---", "---"] + ["---:"] * (len(header) - 2)) + "|"]
+    for row in summary:
+        cells = [str(row["scenario"]), str(row["label"]), str(row["runs"]), f"{row['successes']}/{row['runs']}",
+                 "–" if row.get("reference") is None else f"{row['reference']:g}"]
+        for m in metrics:
+            mean, median = row.get(f"{m}_mean"), row.get(f"{m}_median")
+            cells.append(format_mean_std(mean, row.get(f"{m}_std"), digits=3)
+                         + ("" if median is None else f" ({median:.3f})"))
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def write_summary(summary: Sequence[Mapping[str, Any]], folder: str | os.PathLike, *,
+                  name: str = "summary") -> tuple[Path, Path]:
+    """Write a :func:`summarise` table as ``folder/<name>.csv`` and ``folder/<name>.md``, atomically.
+
+    Returns
+    -------
+    (Path, Path)
+        The CSV and Markdown files.
+
+    Raises
+    ------
+    OutputError
+        If a file cannot be written (the folder must exist).
+    """
+    summary = _check_rows(summary, "summary")
+    if not isinstance(folder, (str, os.PathLike)):
+        raise ParameterError(f"folder must be a folder path, got {folder!r}")
+    if not isinstance(name, str) or not _NAME.fullmatch(name):
+        raise ParameterError(f"name must be letters, digits, '_', '.' or '-', got {name!r}")
+    folder = Path(folder)
+    return (write_text(folder / f"{name}.csv", _summary_csv(summary), what="study summary"),
+            write_text(folder / f"{name}.md", markdown_summary(summary), what="study summary"))
