@@ -1,4 +1,4 @@
-"""pymoo algorithms and terminations over seed 000's command chromosomes.
+"""pymoo algorithms and terminations over Cheng et al. 2020's command chromosomes.
 
 - :class:`HTetroGA`: the paper's hTetro-GA (Cheng et al. 2020) as a pymoo ``GeneticAlgorithm``, with
   our additions switchable (:meth:`HTetroGA.as_published` turns them off);

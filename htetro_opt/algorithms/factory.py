@@ -1,4 +1,4 @@
-"""The pymoo algorithms that run over seed 000's command chromosomes, by name.
+"""The pymoo algorithms that run over Cheng et al. 2020's command chromosomes, by name.
 
 The same :class:`~htetro_opt.problems.CommandPathProblem` and operators run under the paper's
 hTetro-GA (with our additions, or as published) and under four of pymoo's own algorithms, so that a

@@ -1,7 +1,7 @@
 """The leading front of a command-chromosome population and the paper's four output solutions.
 
 :func:`leading_front` is F0 (the goal-reaching individuals' non-dominated set, or everyone's when none
-reaches), :func:`select_solutions` picks seed 000's four solutions from it, and
+reaches), :func:`select_solutions` picks Cheng et al. 2020's four solutions from it, and
 :class:`ConvergenceRecorder` logs them per generation under any pymoo algorithm (the paper's Fig. 10).
 """
 

@@ -362,7 +362,7 @@ SELECTION_STYLES = {
     "smoothness": ("#2ca02c", "best f_sm"),
     "safety": ("#9467bd", "best f_sf"),
 }
-"""Colour and legend label of each of the paper's four output solutions (seed 000's Fig. 9)."""
+"""Colour and legend label of each of the paper's four output solutions (Cheng et al. 2020, Fig. 9)."""
 
 _FITNESS_STYLES = (("f_gr", "black"), ("f_t", "#1f77b4"), ("f_sm", "#2ca02c"), ("f_sf", "#9467bd"))
 
@@ -383,7 +383,7 @@ def _selection_track(plan, name: str, offset: float):
 def plot_ga_plan(workspace: Workspace, plan, *, roadmap: tuple[Pose, ...] = (), hidden=None, title: str = ""):
     """A GA plan: the four selected solutions' paths, and the convergence of the chosen one.
 
-    These are the paper's (seed 000) Figs. 9 and 10.
+    These are the paper's (Cheng et al. 2020) Figs. 9 and 10.
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""Plots of seed 003's tilesets, waypoint orders (Figs. 13–14) and coverage heat maps (Fig. 18).
+"""Plots of Le et al. 2018's tilesets, waypoint orders (Figs. 13–14) and coverage heat maps (Fig. 18).
 
 matplotlib is imported only inside the functions; nothing here computes a plan or a simulation.
 """
@@ -76,7 +76,7 @@ def _visit_step(n: int, most: int = _MOST_VISIT_NUMBERS) -> int:
 
 
 def plot_tileset(tileset: Tileset, order=None, *, title: str = "", ax=None):
-    """Draw a labelled tileset and, optionally, a visiting order (seed 003's Figs. 13–14).
+    """Draw a labelled tileset and, optionally, a visiting order (Le et al. 2018, Figs. 13–14).
 
     Tiles are filled with their morphology's colour (:data:`SHAPE_COLOURS`; one image, darker where
     tiles overlap), tile borders are drawn thick and obstacles dark. With an order, the path joins
@@ -222,7 +222,7 @@ def _draw_order(ax, refs: np.ndarray, cell_pt: float) -> list:
 
 
 def plot_coverage(result, *, title: str = "", ax=None):
-    """Draw a coverage heat map (seed 003's Fig. 18): pixel time scaled to 0…255, green to red.
+    """Draw a coverage heat map (Le et al. 2018, Fig. 18): pixel time scaled to 0…255, green to red.
 
     Parameters
     ----------
