@@ -422,25 +422,12 @@ def plot_ga_plan(workspace: Workspace, plan, *, roadmap: tuple[Pose, ...] = (), 
     _legend(ax_map, handles)
     _frame(ax_map, workspace, title)
 
-    start = 1
-    for j, leg in enumerate(plan.legs):
-        history = np.asarray(leg.history).reshape(-1, 4)
-        gens = np.arange(start, start + len(history))
-        for i, (name, colour) in enumerate(_FITNESS_STYLES):
-            ax_fit.plot(gens, history[:, i], color=colour, linewidth=1.4, label=name if j == 0 else None)
-        if leg.reach_generation is not None:
-            ax_fit.axvline(start + leg.reach_generation - 1, color="red", linestyle=":", linewidth=1.0,
-                           label="goal first reached" if j == 0 else None)
-        if j:
-            ax_fit.axvline(start - 0.5, color="#888888", linestyle="--", linewidth=0.8,
-                           label="next leg" if j == 1 else None)
-        start += len(history)
-    ax_fit.set_xlabel("generation" + (" (legs one after another)" if len(plan.legs) > 1 else ""))
-    ax_fit.set_ylabel("fitness (higher is better)")
-    ax_fit.set_title("convergence of the multi-objective solution's fitnesses", fontsize=10)
-    ax_fit.grid(alpha=0.3)
     if plan.legs:
-        ax_fit.legend(fontsize=8, loc="lower right")
+        from htetro_opt.viz.fronts import _draw_convergence  # the one convergence drawing (fronts imports this module)
+
+        _draw_convergence(ax_fit, [(np.asarray(leg.history, dtype=float).reshape(-1, 4), leg.reach_generation)
+                                   for leg in plan.legs])
+    ax_fit.set_title("convergence of the multi-objective solution's fitnesses", fontsize=10)
     return fig
 
 
