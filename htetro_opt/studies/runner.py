@@ -54,6 +54,34 @@ and writes the :func:`summarise` table to ``DIR/<name>.csv`` and ``DIR/<name>.md
 and seeds give the same records (:data:`RUNTIME_FIELDS` aside), whatever the executor and however
 often the run was interrupted; a method that stops on a time budget rather than by itself (``ortools``,
 ``time_limit`` cut-offs) depends on the machine's speed, as it does on the command line.
+
+**Multi-objective metrics** (metric ``"front"``, ``plan`` with the GA methods only). A trial records
+the leading front F0 of its last leg's final population (:attr:`LegResult.front`: the goal-reaching
+individuals' non-dominated set, or everyone's when none reaches) as its distinct
+``[f_gr, f_t, f_sm, f_sf]`` rows, rounded to 6 decimals, and the **hypervolume** ``hv`` of those
+rows (:func:`hypervolume`). Both indicators are computed in pymoo's minimisation space,
+F = −(f_gr, f_t, f_sm, f_sf), as in the notebook ``01_htetro_ga_pareto``, with the same choices:
+
+- HV's reference point is :data:`HV_REFERENCE`, r = (0, 1, 0, 0), i.e. f_gr = 0, f_t = −1,
+  f_sm = 0, f_sf = 0, fixed in advance, the same for every method, seed and scenario, and not taken
+  from the runs (a data-derived point would change with the set of runs compared). f_gr, f_sm and
+  f_sf lie in [0, 1] and 0 is the worst value each can take, so r is their nadir: every point with
+  some goal progress, smoothness and safety counts. f_t has no lower bound (a path slower than
+  t_max has f_t < 0); f_t = −1 is a path taking 2 t_max, the time of the longest all-translation
+  chromosome the operators keep (offspring are cut at 2 l_p,max genes); slower members add nothing.
+  The box between the ideal point (−1, −1, −1, −1) and r has volume 2, so 0 ≤ HV ≤ 2.
+- **IGD+** (Ishibuchi et al. 2015, pymoo's ``IGDPlus``; lower is better, 0 when a run found the
+  whole reference front) needs every run: :func:`front_metrics`, applied by :func:`summarise`,
+  measures each record's front against the reference front of its scenario: the union of the
+  fronts of every method and seed, reduced to its leading front (the best approximation of the true
+  front these runs found), in the same unnormalised space. Trials whose ``clearance`` or
+  ``max_length`` differ optimise different fitnesses (t_max = l_p,max × 1 s scales f_t) and are not
+  pooled. The results file keeps the per-trial ``hv``; ``igd_plus`` is recomputed from the records'
+  fronts, so :func:`summarise` of a results file gives the run's summary.
+
+Metric ``"history"`` records the convergence curve the GA keeps: the last leg's multi-objective
+solution's ``[f_gr, f_t, f_sm, f_sf]`` per generation (:attr:`LegResult.history`, the paper's
+Fig. 10). The front itself is not kept per generation, so there is no hypervolume-by-generation curve.
 """
 
 from __future__ import annotations
@@ -80,6 +108,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from htetro_opt import __version__
 from htetro_opt._files import write_text
 from htetro_opt._progress import check_progress, report
@@ -94,6 +124,7 @@ from htetro_opt.studies.metrics import (
 
 __all__ = [
     "EXECUTORS",
+    "HV_REFERENCE",
     "METRICS",
     "RUNTIME_FIELDS",
     "TASKS",
@@ -101,11 +132,13 @@ __all__ = [
     "Study",
     "StudyError",
     "StudyRun",
-    "markdown_summary",
     "Trial",
     "WorkerLost",
+    "front_metrics",
+    "hypervolume",
     "list_studies",
     "load_study",
+    "markdown_summary",
     "read_records",
     "reference_trial",
     "run_reference",
@@ -122,7 +155,7 @@ EXECUTORS = ("serial", "processes", "dask")
 """Where the trials run: in this process, on a local process pool, on a Dask cluster."""
 
 METRICS = {
-    "plan": ("objectives", "generations", "fitness", "gap"),
+    "plan": ("objectives", "generations", "fitness", "gap", "front", "history"),
     "tile": (),
     "sequence": ("gap",),
 }
@@ -136,14 +169,28 @@ METRICS = {
 - ``fitness``: the GAs' ``f_gr``, ``f_t``, ``f_sm``, ``f_sf`` of the multi-objective solution,
   averaged over the legs (Cheng et al. 2020's Table 4);
 - ``gap``: ``reference`` (the exact optimum's time or cost) and ``gap`` = (value − reference) /
-  reference; for ``sequence`` only where the optimum is proven (≤ 40 waypoints)."""
+  reference; for ``sequence`` only where the optimum is proven (≤ 40 waypoints);
+- ``front`` (the GA methods only): ``front``, the last leg's leading front as distinct
+  ``[f_gr, f_t, f_sm, f_sf]`` rows rounded to 6 decimals, and ``hv``, its hypervolume
+  (:func:`hypervolume`); the summary adds ``igd_plus`` (:func:`front_metrics`);
+- ``history`` (the GA methods only): ``history``, the last leg's multi-objective solution's
+  ``[f_gr, f_t, f_sm, f_sf]`` per generation, rounded to 6 decimals (the convergence curve)."""
+
+HV_REFERENCE = (0.0, 1.0, 0.0, 0.0)
+"""The hypervolume's reference point in pymoo's minimisation space F = −(f_gr, f_t, f_sm, f_sf):
+f_gr = 0, f_t = −1 (a path taking twice t_max), f_sm = 0, f_sf = 0; fixed for every study, and the
+notebook ``01_htetro_ga_pareto``'s (the module docstring gives the reasons)."""
+
+_GA_METRICS = ("front", "history")  # the exact planners have no population, hence no front
+_FRONT_DIGITS = 6
 
 RUNTIME_FIELDS = ("runtime_s", "reach_time_s")
 """Wall-clock fields of a record: the only ones that differ between two runs of the same trial."""
 
 _METRIC_FIELDS = {
     "plan": ("reached", "time", "n_commands", "translations", "rotations", "shapeshifts", "path_length",
-             "generations", "reach_generation", "reach_time_s", "f_gr", "f_t", "f_sm", "f_sf", "reference", "gap"),
+             "generations", "reach_generation", "reach_time_s", "f_gr", "f_t", "f_sm", "f_sf", "reference", "gap",
+             "hv", "igd_plus"),
     "tile": ("tiles", "overlapping", "n_I", "n_O", "n_L", "n_J", "n_Z", "n_S", "n_T"),
     "sequence": ("cost", "waypoints", "optimal", "reference", "gap"),
 }
@@ -451,6 +498,8 @@ class Study:
         seeds = _check_seeds(self.seeds, f"{where}: seeds")
         metrics = _check_metrics(self.task, self.metrics, where)
         methods = _check_methods(self.task, self.methods, scenarios, written, where)
+        for i, spec in enumerate(methods):
+            _check_ga_metrics(self.task, spec.method, metrics, f"{where}, methods[{i}]")
         object.__setattr__(self, "scenarios", scenarios)
         object.__setattr__(self, "seeds", seeds)
         object.__setattr__(self, "metrics", metrics)
@@ -528,6 +577,14 @@ def _check_metrics(task, metrics, where) -> tuple[str, ...]:
             raise StudyError(f"{where}: metrics[{i}]: unknown metric {metric!r} for task {task}: expected "
                              f"{', '.join(known) if known else 'none (its records hold every metric)'}")
     return tuple(m for m in known if m in metrics)
+
+
+def _check_ga_metrics(task, method, metrics, where) -> None:
+    """Refuse a metric of the GAs' populations (:data:`_GA_METRICS`) for a method that has none."""
+    for metric in metrics:
+        if metric in _GA_METRICS and not _takes(task, method, "ga"):
+            raise StudyError(f"{where}: metric {metric!r} applies to the GA methods only, not to {method}: an exact "
+                             "planner has no front (metric 'gap' compares the GAs with its optimum)")
 
 
 def _check_options(task, method, options, scenarios, where) -> dict:
@@ -695,9 +752,11 @@ def _head(inputs: Mapping[str, Any]) -> dict:
 
 
 def _finite(value):
-    """A JSON-ready scalar: numpy's as Python's, NaN and infinities as None."""
+    """A JSON-ready scalar, or list of them: numpy's as Python's, NaN and infinities as None."""
     if value is None or isinstance(value, (bool, str)):
         return value
+    if isinstance(value, (list, tuple)):
+        return [_finite(v) for v in value]
     if isinstance(value, numbers.Integral):
         return int(value)
     value = float(value)
@@ -739,7 +798,20 @@ def _plan(scenario, method, parameters, seed, metrics) -> tuple[dict, dict, floa
         fitness = [leg.selected["multi_objective"].fitness for leg in legs]
         out.update({name: sum(float(f[i]) for f in fitness) / len(fitness) if fitness else None
                     for i, name in enumerate(FITNESS_NAMES)})
+    if "front" in metrics:  # a GA's plan has a leg, the failed one's included
+        front = _fitness_rows([member.fitness for member in legs[-1].front], unique=True)
+        out["front"], out["hv"] = front, hypervolume(front)
+    if "history" in metrics:
+        out["history"] = _fitness_rows(legs[-1].history, unique=False)
     return out, {"commands": ",".join(plan.tokens)}, plan.runtime_s
+
+
+def _fitness_rows(fitness, *, unique: bool) -> list[list[float]]:
+    """(f_gr, f_t, f_sm, f_sf) rows, rounded to 6 decimals, as lists (distinct and sorted if ``unique``)."""
+    rows = np.round(np.asarray(fitness, dtype=float).reshape(-1, 4), _FRONT_DIGITS) + 0.0  # + 0.0: no -0.0
+    if unique:
+        rows = np.unique(rows, axis=0)
+    return rows.tolist()
 
 
 def _tile(scenario, method, parameters, seed) -> tuple[dict, dict, float]:
@@ -850,6 +922,7 @@ def run_trial(task: str, scenario: str, method: str, parameters: Mapping[str, An
     method = _canonical_method(task, method)
     try:
         metrics = _check_metrics(task, metrics, "run_trial")
+        _check_ga_metrics(task, method, metrics, "run_trial")
     except StudyError as err:
         raise ParameterError(str(err)) from None
     head = _head(_inputs("trial", task, scenario, method, method if label is None else label, seed, parameters,
@@ -1304,6 +1377,132 @@ def _outcomes(calls, executor, workers, scheduler, retries):
                 outcomes.close()
 
 
+# --- multi-objective metrics -----------------------------------------------------------------------
+def _objectives(front, what: str) -> np.ndarray:
+    """Fitness rows [f_gr, f_t, f_sm, f_sf] as pymoo's minimisation objectives, shape (n, 4)."""
+    try:
+        fitness = np.asarray(front, dtype=float)
+    except (TypeError, ValueError):
+        fitness = None
+    if fitness is None or not (fitness.ndim == 2 and fitness.shape[1] == 4 or fitness.size == 0) \
+            or not np.isfinite(fitness).all():
+        raise ParameterError(f"{what} must be rows of four finite fitnesses [f_gr, f_t, f_sm, f_sf], "
+                             f"got {front!r:.80}")
+    return -fitness.reshape(-1, 4)
+
+
+def hypervolume(front) -> float:
+    """The hypervolume of a front of fitnesses, against the fixed reference point :data:`HV_REFERENCE`.
+
+    Parameters
+    ----------
+    front : array-like, shape (n, 4)
+        [f_gr, f_t, f_sm, f_sf] rows (fitnesses, maximised), as a record's ``front``.
+
+    Returns
+    -------
+    float
+        pymoo's ``HV`` of −front: the volume of the region of the minimisation space dominated by
+        the front and dominating :data:`HV_REFERENCE`; 0 for an empty front. At most 2.
+
+    Raises
+    ------
+    ParameterError
+        If ``front`` is not rows of four finite numbers.
+
+    Examples
+    --------
+    One point spans a box to the reference point: 1 × (0.5 + 1) × 0.5 × 0.5; a second one adds its
+    own box (1 × 1 × 1 × 1) less their overlap (1 × 1 × 0.5 × 0.5):
+
+    >>> hypervolume([[1.0, 0.5, 0.5, 0.5]])
+    0.375
+    >>> hypervolume([[1.0, 0.5, 0.5, 0.5], [1.0, 0.0, 1.0, 1.0]])
+    1.125
+    """
+    from pymoo.indicators.hv import HV
+
+    F = _objectives(front, "front")
+    if len(F) == 0:
+        return 0.0
+    return float(HV(ref_point=np.array(HV_REFERENCE))(F))
+
+
+def _pool(record: Mapping[str, Any]) -> tuple:
+    """The trials whose fronts are compared: one scenario, one fitness definition (clearance changes the
+    moves and safety, max_length the f_t scale; clearance 0 is the default)."""
+    clearance = record.get("clearance")
+    return (record.get("task"), record.get("scenario"), 0.0 if clearance is None else float(clearance),
+            record.get("max_length"))
+
+
+def front_metrics(records: Iterable[Mapping[str, Any]]) -> list[dict]:
+    """The records, those with a ``front`` given ``igd_plus``: IGD+ against their scenario's reference front.
+
+    The reference front of a scenario is the union of the fronts of all its records (every method
+    and seed; records of another ``clearance`` or ``max_length`` are another problem, pooled apart),
+    reduced to its leading front (:func:`~htetro_opt.algorithms.leading_front`: the goal-reaching
+    points' non-dominated set, or all points' when none reaches the goal). IGD+ (pymoo's
+    ``IGDPlus``) is the mean, over the reference points z, of the distance to the nearest front
+    point a counting only where a is worse: min_a ‖max(a − z, 0)‖ in the minimisation space
+    F = −(f_gr, f_t, f_sm, f_sf). The result depends on the records only, not on their order.
+
+    Parameters
+    ----------
+    records : iterable of dict
+        Trial records (references and records without a front are returned unchanged).
+
+    Returns
+    -------
+    list of dict
+        New dicts, in order; ``igd_plus`` follows ``hv``.
+
+    Raises
+    ------
+    ParameterError
+        If a record's ``front`` is not rows of four finite fitnesses.
+
+    Examples
+    --------
+    >>> records = [{"task": "plan", "scenario": "a", "front": [[1.0, 0.5, 0.5, 0.5]], "hv": 0.375},
+    ...            {"task": "plan", "scenario": "a", "front": [[1.0, 0.5, 0.9, 0.5]], "hv": 0.675}]
+    >>> [round(r["igd_plus"], 6) for r in front_metrics(records)]
+    [0.4, 0.0]
+    """
+    from pymoo.indicators.igd_plus import IGDPlus
+
+    from htetro_opt.algorithms import leading_front
+
+    records = _check_rows(records, "records")
+    objectives: list[np.ndarray | None] = []
+    pools: dict[tuple, list[np.ndarray]] = {}
+    for i, record in enumerate(records):
+        front = record.get("front") if record.get("kind", "trial") != "reference" else None
+        F = None if front is None else _objectives(front, f"records[{i}]['front']")
+        objectives.append(F)
+        if F is not None and len(F):
+            pools.setdefault(_pool(record), []).append(F)
+    references = {}
+    for pool, fronts in pools.items():
+        union = np.unique(np.vstack(fronts), axis=0)  # sorted: the same for any order of the records
+        references[pool] = union[leading_front(union)]
+    out = []
+    for record, F in zip(records, objectives):
+        if F is None:
+            out.append(dict(record))
+            continue
+        value = float(IGDPlus(references[_pool(record)])(F)) if len(F) else None
+        row = {}
+        for k, v in record.items():
+            if k != "igd_plus":
+                row[k] = v
+            if k == "hv":
+                row["igd_plus"] = value
+        row.setdefault("igd_plus", value)
+        out.append(row)
+    return out
+
+
 # --- summaries -------------------------------------------------------------------------------------
 def _success(record: Mapping[str, Any]) -> bool:
     return record.get("error") is None and record.get("reached") is not False
@@ -1318,6 +1517,8 @@ def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict]:
     ``reference`` (the exact optimum, where the study measured gaps), and for each numeric metric
     present in the records (``runtime_s`` included) ``<metric>_mean``, ``<metric>_std`` (sample
     standard deviation, None for one value) and ``<metric>_median``, over the runs that measured it.
+    Records with a ``front`` (metric ``"front"``) are first given their ``igd_plus`` against all
+    the records' fronts (:func:`front_metrics`), so that the rows hold ``hv_*`` and ``igd_plus_*``.
 
     Examples
     --------
@@ -1330,7 +1531,7 @@ def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict]:
     (3, 1, 0.3333333333333333, 30.0, 30.0)
     """
     records = _check_rows(records, "records")
-    records = [r for r in records if r.get("kind", "trial") != "reference"]
+    records = front_metrics(r for r in records if r.get("kind", "trial") != "reference")
     fields = [k for task in TASKS if any(r.get("task") == task for r in records) for k in _METRIC_FIELDS[task]]
     numeric = [k for k in dict.fromkeys(fields + ["runtime_s"])
                if k != "reference" and any(_is_number(r.get(k)) for r in records)]
