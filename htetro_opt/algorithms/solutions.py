@@ -84,12 +84,19 @@ class ConvergenceRecorder(Callback):
     on_generation : callable, optional
         Called after each generation as ``on_generation(generation, best_f_t, reached)``: the best
         f_t among goal-reaching individuals (None while none reaches).
+    hv_reference : sequence of 4 float, optional
+        With it, ``hv_history`` records per generation the hypervolume (pymoo's ``HV``) of the leading
+        front against this reference point, in pymoo's minimisation space F = −(f_gr, f_t, f_sm, f_sf):
+        the convergence curve of the whole front, not only of one solution. Off by default (it costs
+        an HV computation a generation).
     """
 
-    def __init__(self, began: float | None = None, on_generation=None) -> None:
+    def __init__(self, began: float | None = None, on_generation=None, hv_reference=None) -> None:
         super().__init__()
         self.began = _time.perf_counter() if began is None else began
         self.on_generation = on_generation
+        self.hv_reference = None if hv_reference is None else np.asarray(hv_reference, dtype=float)
+        self.hv_history: list[float] = []
         self.reach_generation: int | None = None
         self.reach_time_s: float | None = None
         self.history: list[np.ndarray] = []
@@ -101,6 +108,10 @@ class ConvergenceRecorder(Callback):
             self.reach_generation = int(algorithm.n_gen)
             self.reach_time_s = _time.perf_counter() - self.began
         self.history.append(-F[select_solutions(F)["multi_objective"]])
+        if self.hv_reference is not None:
+            from pymoo.indicators.hv import HV
+
+            self.hv_history.append(float(HV(ref_point=self.hv_reference)(F[leading_front(F)])))
         if self.on_generation is not None:
             best_f_t = float(-F[reached, 1].min()) if reached.any() else None
             self.on_generation(int(algorithm.n_gen), best_f_t, bool(reached.any()))

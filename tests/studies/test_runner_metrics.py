@@ -237,3 +237,22 @@ def test_ga_metrics_on_an_exact_method_name_the_entry(tmp_path, metric):
 def test_front_on_another_task_is_refused(task, scenario, method):
     with pytest.raises(StudyError, match=r"metrics\[0\]: unknown metric 'front' for task " + task):
         Study(name="d", task=task, scenarios=[scenario], metrics=["front"], methods=[{"method": method}])
+
+
+def test_hv_curve_is_the_front_hypervolume_by_generation_and_never_falls_behind_the_final_front():
+    from htetro_opt.studies.runner import HV_REFERENCE, hypervolume, run_trial
+
+    record = run_trial("plan", "three_slit", "htetro-ga", {"pop_size": 12, "max_gen": 15, "patience": 5},
+                       3, metrics=("front", "hv_curve", "generations"))
+    curve = record["hv_curve"]
+    assert len(curve) == record["generations"] and all(v >= 0 for v in curve)
+    # the last generation's value is the final front's hypervolume (computed independently from the rows)
+    assert curve[-1] == pytest.approx(hypervolume(record["front"]), abs=1e-5)
+    assert HV_REFERENCE == (0.0, 1.0, 0.0, 0.0)
+
+
+def test_hv_curve_is_refused_for_an_exact_method():
+    from htetro_opt.studies.runner import run_trial
+
+    with pytest.raises(Exception, match="hv_curve"):
+        run_trial("plan", "three_slit", "dijkstra", {}, None, metrics=("hv_curve",))

@@ -25,6 +25,7 @@ from htetro_opt.algorithms import (
     make_algorithm,
     select_solutions,
 )
+from htetro_opt.errors import ParameterError
 from htetro_opt.model.commands import SEED000_COMMANDS, Timing
 from htetro_opt.model.robot import Pose
 from htetro_opt.model.simulate import Simulator
@@ -62,6 +63,16 @@ def default_max_length(workspace: Workspace, start: Pose, goal: Pose) -> int:
     return max(DEFAULT_MAX_LENGTH, int(np.ceil(2 * distance)))
 
 
+def _check_reference(point) -> tuple[float, ...]:
+    try:
+        values = tuple(float(v) for v in point)
+    except (TypeError, ValueError):
+        values = ()
+    if len(values) != 4 or not all(np.isfinite(values)):
+        raise ParameterError(f"hv_reference must be four finite numbers (a point in F = −fitness), got {point!r}")
+    return values
+
+
 def _reporter(progress, leg: int, legs: int, max_gen: int):
     """The recorder's per-generation hook that reports to ``progress``."""
     if progress is None:
@@ -91,6 +102,7 @@ def plan_ga(
     clearance: float = 0.0,
     verbose: bool = False,
     progress=None,
+    hv_reference=None,
 ) -> Plan:
     """Plan through a roadmap with a command-chromosome GA, one optimisation per leg.
 
@@ -125,6 +137,10 @@ def plan_ga(
     progress : callable, optional, keyword-only
         ``progress(generation, max_gen, note)`` after every generation, the note giving the leg and
         the best f_t reached so far (see :mod:`htetro_opt._progress`).
+    hv_reference : sequence of 4 float, optional, keyword-only
+        Record each leg's hypervolume by generation against this reference point (in pymoo's
+        minimisation space; see :class:`~htetro_opt.algorithms.ConvergenceRecorder`) as
+        ``LegResult.hv_history``.
 
     Returns
     -------
@@ -156,6 +172,7 @@ def plan_ga(
     patience = check_int(patience, "patience", minimum=1)
     max_length = check_int(max_length, "max_length", minimum=1, allow_none=True)
     progress = check_progress(progress)
+    reference = None if hv_reference is None else _check_reference(hv_reference)
     seed = check_seed(seed)
     verbose = check_bool(verbose, "verbose")
     began = _time.perf_counter()
@@ -172,7 +189,8 @@ def plan_ga(
         leg_began = _time.perf_counter()
         length = max_length if max_length is not None else default_max_length(sim.workspace, start, goal)
         problem = CommandPathProblem(sim, start, goal, max_length=length, t0=t0)
-        recorder = ConvergenceRecorder(leg_began, _reporter(progress, leg, len(roadmap) - 1, max_gen))
+        recorder = ConvergenceRecorder(leg_began, _reporter(progress, leg, len(roadmap) - 1, max_gen),
+                                       hv_reference=reference)
         termination = FrontConvergence(max_gen=max_gen, patience=patience)
         res = minimize(problem, make_algorithm(algorithm, pop_size, sampling_weights=sampling_weights),
                        termination, seed=int(leg_seeds[leg]), callback=recorder, verbose=verbose)
@@ -192,6 +210,7 @@ def plan_ga(
             converged=bool(res.data.get("converged", False)),  # minimize runs a copy of the termination
             runtime_s=_time.perf_counter() - leg_began,
             history=np.array(recorder.history),
+            hv_history=None if reference is None else np.array(recorder.hv_history),
         ))
         if not reached:
             failed = leg

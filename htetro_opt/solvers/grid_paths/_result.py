@@ -70,6 +70,7 @@ class LegResult:
     converged: bool
     runtime_s: float
     history: np.ndarray
+    hv_history: np.ndarray | None = None  # per generation, when asked for (plan_ga's hv_reference)
 
 
 @dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
