@@ -45,7 +45,7 @@ from htetro_opt.model import SEED000_COMMANDS, Simulator
 from htetro_opt.problems import CommandPathProblem
 from htetro_opt.scenarios import load_scenario
 from htetro_opt.studies.metrics import format_mean_std
-from htetro_opt.studies.table4 import ENVIRONMENTS, run_study, summarise
+from htetro_opt.studies.table4 import ENVIRONMENTS, run_table4, summarise
 
 TIMING_MAPS = ("three_slit", "random")
 POP_SIZES = (50, 100)
@@ -216,15 +216,15 @@ def print_split(rows: list[dict]) -> None:
 
 
 def quality(seeds: int, max_gen: int, jobs: int, methods: list[str]) -> list[dict]:
-    def report(done, total, record):
-        print(f"  [{done}/{total}] {record['method']} {record['environment']} seed {record['seed']}: "
-              f"{'reached' if record['reached'] else 'not reached'}, {record['terminate_time_s']:.1f} s",
-              file=sys.stderr, flush=True)
+    def report(done, total, note):
+        print(f"  [{done}/{total}] {note}", file=sys.stderr, flush=True)
 
     records = []
     for method in methods:
-        records += run_study(ENVIRONMENTS, [50], range(seeds), max_gen=max_gen, method=method,
-                             jobs=jobs, progress=report)
+        run = run_table4(ENVIRONMENTS, [50], range(seeds), max_gen=max_gen, method=method,
+                         executor="serial" if jobs == 1 else "processes", workers=None if jobs == 1 else jobs,
+                         progress=report)
+        records += run.records
     return records
 
 
@@ -240,13 +240,13 @@ def print_quality(records: list[dict], seeds: int, max_gen: int) -> None:
     for row in summarise(records):
         lo, hi = row["exact_time_min"], row["exact_time_max"]
         exact = "–" if lo is None else (f"{lo:g}" if lo == hi else f"{lo:g}–{hi:g}")
-        print(f"| {row['environment']} | {row['method']} | {row['reached']}/{row['runs']} "
+        print(f"| {row['scenario']} | {row['method']} | {row['reached']}/{row['runs']} "
               f"| {format_mean_std(row['reach_generation_mean'], row['reach_generation_std'], digits=1)} "
               f"| {format_mean_std(row['terminate_generation_mean'], row['terminate_generation_std'], digits=1)} "
               f"| {format_mean_std(row['terminate_time_s_mean'], row['terminate_time_s_std'], digits=1)} "
               f"| {exact} | {format_mean_std(row['best_time_mean'], row['best_time_std'], digits=1)} "
-              f"| {gap(row['gap_mean'])} | {gap(row['gap_max'])} "
-              f"| {'–' if row['plan_time_mean'] is None else format(row['plan_time_mean'], '.1f')} |")
+              f"| {gap(row['best_gap_mean'])} | {gap(row['best_gap_max'])} "
+              f"| {'–' if row['time_mean'] is None else format(row['time_mean'], '.1f')} |")
     print()
 
 

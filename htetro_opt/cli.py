@@ -599,16 +599,23 @@ def _cmd_study(args) -> dict:
     workers = check_int(args.workers, "--workers", minimum=1, allow_none=True)
     retries = check_int(args.retries, "--retries", minimum=0)
     out = _study_folder(args.out)
+    # Table 4 of Cheng et al. 2020 records the paper's own measures, and its report sets them beside the paper's
+    paper = None
+    if study.name == "table4":
+        from htetro_opt.studies import table4 as paper
     console = _console(args)
     with console.step(f"study {study.name}", 1, "trials") as progress:
         run = run_study(study, out=out, executor=args.executor, workers=workers, scheduler=args.scheduler,
-                        seeds=seeds, resume=args.resume, retries=retries, progress=progress)
+                        seeds=seeds, resume=args.resume, retries=retries, progress=progress,
+                        trial=None if paper is None else paper.trial)
     if run.dashboard and not args.quiet:
         print(f"dask dashboard: {run.dashboard}", file=sys.stderr)
+    if paper is not None and out is not None:
+        _late(run.as_dict(), lambda: write_text(out / f"{study.name}_paper.md", paper.report(run), what="study report"))
     if not args.json:
         from htetro_opt.studies.runner import markdown_summary
 
-        print(markdown_summary(run.summary), end="")
+        print(paper.report(run) if paper is not None else markdown_summary(run.summary), end="")
         if run.path is not None:
             print(f"\n{len(run.records)} trials ({run.failed} failed) recorded in {run.path}")
     return run.as_dict()

@@ -949,3 +949,16 @@ def test_bad_study_files_are_one_error_line_and_write_nothing(capsys, tmp_path, 
 ])
 def test_study_options_that_do_not_fit_are_refused(capsys, argv, words):
     assert_one_error_line(*run(capsys, argv), *words)
+
+
+def test_study_table4_prints_ours_beside_the_papers(capsys, tmp_path):
+    study = tmp_path / "table4.toml"  # the name selects Table 4's trial and report
+    study.write_text('name = "table4"\ntask = "plan"\nscenarios = ["three_slit"]\nseeds = 1\n'
+                     'metrics = ["generations", "fitness", "gap"]\n'
+                     '[[methods]]\nmethod = "htetro-ga"\npop_size = 12\nmax_gen = 5\npatience = 3\nmax_length = 100\n')
+    out_dir = tmp_path / "out"
+    code, out, err = run(capsys, ["study", str(study), "--executor", "serial", "--out", str(out_dir)])
+    assert code == 0, err
+    assert "| three_slit | 12 |" in out and "exact optimum" in out
+    report = (out_dir / "table4_paper.md").read_text().strip()
+    assert report.startswith("| environment") and report in out

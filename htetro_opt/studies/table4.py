@@ -5,10 +5,14 @@ with n_pop = 25, 50 and 100, l_p,max = 200 on the spiral map and 100 elsewhere, 
 generations, and reports per cell of its Table 4 the mean ± standard deviation of the generation at
 which some individual first reaches the goal ("reach population"), the generation at which the run
 stops ("terminate population"), the wall-clock times of both, and the four fitnesses of the output
-("multi-objective based") solution. :data:`PAPER_TABLE4` holds those numbers; :func:`run_study`
-re-runs the experiment with :func:`~htetro_opt.solvers.grid_paths.plan_ga` on the bundled scenarios of the same
-names, and also measures what the paper could not: how far each GA plan is from the exact
-minimum-time plan (:func:`~htetro_opt.solvers.grid_paths.plan_exact`, same start, goal and obstacle clock).
+("multi-objective based") solution. :data:`PAPER_TABLE4` holds those numbers. :func:`run_trial` is one
+run, measured as Table 4 does with :func:`~htetro_opt.solvers.grid_paths.plan_ga` on the bundled
+scenario of the same name, plus what the paper could not measure: how far the GA's best plan is from
+the exact minimum-time plan (:func:`~htetro_opt.solvers.grid_paths.plan_exact`, same start, goal and
+obstacle clock). :func:`trial` is the same run as a trial of the study runner
+(:mod:`htetro_opt.studies.runner`), which runs the grid (the bundled study ``table4``,
+``studies/data/table4.toml``, or :func:`table4_study`), records it and resumes it; :func:`summarise`,
+:func:`markdown_table` and :func:`report` lay its records out as Table 4, ours beside the paper's.
 
 Our environments are reconstructions (the paper's figures are not in our copy, see each scenario's
 ``source``), so the generations and times need not match the paper's; the exact optimum is the
@@ -17,27 +21,28 @@ reference that does not depend on the reconstruction.
 Run from Python::
 
     from htetro_opt.studies import table4
-    records = table4.run_study(["three_slit", "random"], [25, 50], range(3), max_gen=300, jobs=2)
-    print(table4.markdown_table(table4.summarise(records)))
+    from htetro_opt.studies.runner import load_study, run_study
 
-(``htetro-opt study table4`` runs the same grid on the study runner, :mod:`htetro_opt.studies.runner`,
-with its generic summary.)
+    run = run_study(load_study("table4"), trial=table4.trial, seeds=3, out="results", workers=2)
+    print(table4.report(run))
+
+or a smaller grid with :func:`run_table4` (``run_table4(["three_slit", "random"], [25, 50], 3,
+max_gen=300)``), the same study with other settings.
 """
 
 from __future__ import annotations
 
-import csv
-import io
+import itertools
 import math
+import numbers
 import os
-from collections.abc import Callable, Iterable, Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from pathlib import Path
+import statistics
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
-from htetro_opt._files import atomic_path
+from htetro_opt import __version__
 from htetro_opt._validation import check_int
 from htetro_opt.algorithms import GA_ALGORITHMS
 from htetro_opt.errors import ConfigurationError, ParameterError
@@ -52,6 +57,7 @@ from htetro_opt.studies.metrics import (
     mean_std,
     values_of,
 )
+from htetro_opt.studies.runner import Study, StudyRun, Trial, run_study
 
 __all__ = [
     "ENVIRONMENTS",
@@ -59,14 +65,16 @@ __all__ = [
     "PAPER_TABLE4",
     "POP_SIZES",
     "RECORD_FIELDS",
+    "STUDY_METRICS",
     "TABLE4_COLUMNS",
     "TIME_FIELDS",
     "markdown_table",
-    "read_csv",
-    "run_study",
+    "report",
+    "run_table4",
     "run_trial",
     "summarise",
-    "write_csv",
+    "table4_study",
+    "trial",
 ]
 
 ENVIRONMENTS = ("random", "spiral", "h_shape", "three_slit", "perpendicular_dynamic", "parallel_dynamic")
@@ -178,14 +186,24 @@ RECORD_FIELDS = (
     "gap",
     "f_t_gap",
 )
-"""The keys of a :func:`run_trial` record, in CSV column order."""
+"""The keys of a :func:`run_trial` record, in order."""
 
-_INT_FIELDS = {"pop_size", "seed", "max_gen", "patience", "max_length", "legs", "legs_run",
-               "reach_generation", "terminate_generation"}
-_BOOL_FIELDS = {"reached"}
-_STR_FIELDS = {"environment", "method"}
-TIME_FIELDS = ("reach_time_s", "terminate_time_s")
-"""The wall-clock fields of a record: the only ones that differ between two runs of the same trial."""
+TIME_FIELDS = ("reach_time_s", "terminate_time_s", "runtime_s")
+"""The wall-clock fields of a record (``runtime_s`` only in :func:`trial`'s): the only ones that
+differ between two runs of the same trial."""
+
+STUDY_METRICS = ("generations", "fitness", "gap")
+"""The runner metrics the Table-4 study asks for (``studies/data/table4.toml``), the only ones
+:func:`trial` takes: its record holds Table 4's generations and fitnesses, and ``"gap"`` makes the
+runner record each map's exact reference (Dijkstra over the whole roadmap) and the output plan's gap."""
+
+_PAPER_MAX_GEN, _PAPER_PATIENCE = 1000, 100
+_TRIAL_OPTIONS = ("pop_size", "max_gen", "patience", "max_length")
+_IN_HEAD = ("environment", "pop_size", "seed", "method", "max_gen", "patience", "max_length")
+# In a runner record "gap" and "reference" are the runner's (the output plan against the study's
+# reference, written by run_study): Table 4's gap of the best plan there is "best_gap"; "time" is the
+# output plan's time under the runner's name.
+_RENAMED = {"plan_time": "time", "gap": "best_gap"}
 
 
 # --- validation ----------------------------------------------------------------------------------
@@ -201,6 +219,18 @@ def _check_method(method: Any) -> str:
     if method not in GA_ALGORITHMS:
         raise ParameterError(f"unknown method {method!r}: expected one of {', '.join(GA_ALGORITHMS)}")
     return str(method)
+
+
+def _check_list(values: Any, name: str) -> list:
+    """A non-empty list of ``values`` (a single str or int is a list of one)."""
+    if isinstance(values, (str, numbers.Integral)):
+        values = [values]
+    if isinstance(values, Mapping) or not isinstance(values, Iterable):
+        raise ParameterError(f"{name} must be a list, got {values!r}")
+    values = list(values)
+    if not values:
+        raise ParameterError(f"{name} must not be empty")
+    return values
 
 
 # --- one trial -----------------------------------------------------------------------------------
@@ -225,8 +255,8 @@ def _sum_or_none(values: Iterable[float | None]) -> float | None:
     return None if not values or any(v is None for v in values) else float(sum(values))
 
 
-def _trial_record(environment: str, pop_size: int, seed: int, method: str, max_gen: int,
-                  patience: int, plan: Plan, sim: Simulator, roadmap: Sequence[Pose], t_max: float) -> dict:
+def _trial_record(environment: str, pop_size: int, seed: int, method: str, max_gen: int, patience: int,
+                  max_length: int, plan: Plan, sim: Simulator, roadmap: Sequence[Pose], t_max: float) -> dict:
     legs = plan.legs
     reached = bool(plan.reached)
     generations = [len(leg.history) for leg in legs]  # generations run: one history row each
@@ -237,7 +267,7 @@ def _trial_record(environment: str, pop_size: int, seed: int, method: str, max_g
     # leg; legs never attempted (after a failed one) continue the exact plan's own clock.
     exact_legs: list[float | None] = []
     clock = 0
-    for i, (start, goal) in enumerate(zip(roadmap[:-1], roadmap[1:])):
+    for i, (start, goal) in enumerate(itertools.pairwise(roadmap)):
         if i < len(legs):
             start, goal, clock = legs[i].start, legs[i].goal, legs[i].t0
         leg = _exact_leg(sim, start, goal, clock)
@@ -267,7 +297,7 @@ def _trial_record(environment: str, pop_size: int, seed: int, method: str, max_g
         "method": method,
         "max_gen": max_gen,
         "patience": patience,
-        "max_length": MAX_LENGTH[environment],
+        "max_length": max_length,
         "legs": len(roadmap) - 1,
         "legs_run": len(legs),
         "reached": reached,
@@ -287,14 +317,34 @@ def _trial_record(environment: str, pop_size: int, seed: int, method: str, max_g
     }
 
 
+def _measure(environment, pop_size, seed, *, max_gen, patience, method, max_length) -> tuple[dict, Plan]:
+    """:func:`run_trial`'s record and the plan it measures."""
+    environment = _check_environment(environment)
+    pop_size = check_int(pop_size, "pop_size", minimum=2)
+    seed = check_int(seed, "seed", minimum=0)
+    max_gen = check_int(max_gen, "max_gen", minimum=1)
+    patience = check_int(patience, "patience", minimum=1)
+    method = _check_method(method)
+    max_length = MAX_LENGTH[environment] if max_length is None else check_int(max_length, "max_length", minimum=1)
+    scenario, sim = _environment(environment)
+    roadmap = list(scenario.roadmap)
+    plan = plan_ga(sim, roadmap, algorithm=method, pop_size=pop_size, max_gen=max_gen,
+                   patience=patience, max_length=max_length, seed=seed)
+    t_max = max_length * sim.timing.translation
+    record = _trial_record(environment, pop_size, seed, method, max_gen, patience, max_length, plan, sim, roadmap,
+                           t_max)
+    return record, plan
+
+
 def run_trial(
     environment: str,
     pop_size: int,
     seed: int,
     *,
-    max_gen: int = 1000,
-    patience: int = 100,
+    max_gen: int = _PAPER_MAX_GEN,
+    patience: int = _PAPER_PATIENCE,
     method: str = "htetro-ga",
+    max_length: int | None = None,
 ) -> dict:
     """One run of the GA through an environment's roadmap, measured as Table 4 does, plus its gap to
     the exact optimum.
@@ -307,13 +357,15 @@ def run_trial(
         n_pop.
     seed : int
         The run's seed (:func:`~htetro_opt.solvers.grid_paths.plan_ga`): the same seed gives the same record,
-        wall-clock fields aside.
+        wall-clock fields (:data:`TIME_FIELDS`) aside.
     max_gen, patience : int, keyword-only
         Termination per leg: at most ``max_gen`` generations, or ``patience`` generations without
         improvement once the goal is reached.
     method : str, keyword-only
         One of :data:`~htetro_opt.algorithms.GA_ALGORITHMS` (default the paper's hTetro-GA with our
         additions; ``"htetro-ga-paper"`` runs it as published).
+    max_length : int, optional, keyword-only
+        l_p,max, the longest chromosome (default the paper's, :data:`MAX_LENGTH`).
 
     Returns
     -------
@@ -341,108 +393,203 @@ def run_trial(
     ------
     ParameterError
         If the environment or method is unknown, or a number is out of range.
+
+    Examples
+    --------
+    >>> record = run_trial("three_slit", 12, 0, max_gen=5)
+    >>> record["exact_time"], record["terminate_generation"], record["max_length"]
+    (33.0, 5, 100)
     """
-    environment = _check_environment(environment)
-    pop_size = check_int(pop_size, "pop_size", minimum=2)
-    seed = check_int(seed, "seed", minimum=0)
-    max_gen = check_int(max_gen, "max_gen", minimum=1)
-    patience = check_int(patience, "patience", minimum=1)
-    method = _check_method(method)
-    scenario, sim = _environment(environment)
-    roadmap = list(scenario.roadmap)
-    max_length = MAX_LENGTH[environment]
-    plan = plan_ga(sim, roadmap, algorithm=method, pop_size=pop_size, max_gen=max_gen,
-                   patience=patience, max_length=max_length, seed=seed)
-    t_max = max_length * sim.timing.translation
-    return _trial_record(environment, pop_size, seed, method, max_gen, patience, plan, sim, roadmap, t_max)
+    return _measure(environment, pop_size, seed, max_gen=max_gen, patience=patience, method=method,
+                    max_length=max_length)[0]
 
 
-def _run_task(task: tuple[str, int, int, dict]) -> dict:
-    environment, pop_size, seed, options = task
-    return run_trial(environment, pop_size, seed, **options)
+def _plain(value):
+    """A JSON-ready scalar (the runner's results file refuses NaN): numpy's as Python's, NaN as None."""
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    value = float(value)
+    return value if math.isfinite(value) else None
+
+
+def _check_trial_parameters(parameters: Any) -> dict:
+    if not isinstance(parameters, Mapping):
+        raise ParameterError(f"parameters must be a mapping of option names to values, got {parameters!r}")
+    unknown = [k for k in parameters if k not in _TRIAL_OPTIONS]
+    if unknown:
+        raise ParameterError(f"the Table-4 trial takes the options {', '.join(_TRIAL_OPTIONS)}, "
+                             f"not {', '.join(map(repr, unknown))}")
+    if "pop_size" not in parameters:
+        raise ParameterError("the Table-4 trial needs pop_size (n_pop) among its parameters")
+    return dict(parameters)
+
+
+def trial(task: str, scenario: str, method: str, parameters: Mapping[str, Any], seed: int, *,
+          label: str | None = None, metrics: Sequence[str] = ()) -> dict:
+    """:func:`run_trial` as a trial of the study runner: ``run_study(study, trial=table4.trial)``.
+
+    The signature is :func:`htetro_opt.studies.runner.run_trial`'s, the record the runner's (its
+    ``key`` that of the study's trial, so that the runner recognises and resumes it).
+
+    Parameters
+    ----------
+    task : {"plan"}
+    scenario : str
+        One of :data:`ENVIRONMENTS`.
+    method : str
+        One of :data:`~htetro_opt.algorithms.GA_ALGORITHMS`.
+    parameters : mapping
+        ``pop_size`` and optionally ``max_gen``, ``patience``, ``max_length`` (defaults as for
+        :func:`run_trial`).
+    seed : int
+    label : str, optional, keyword-only
+        The name of the trial's rows (default: ``method``).
+    metrics : sequence of str, keyword-only
+        The study's metrics, some of :data:`STUDY_METRICS` (the others of
+        :data:`~htetro_opt.studies.runner.METRICS`, such as ``"front"``, are the runner's own trial's):
+        they enter the trial's key; the record holds every Table-4 measure whatever they are.
+
+    Returns
+    -------
+    dict
+        The runner's head (``key``, ``kind``, ``task``, ``scenario``, ``method``, ``label``,
+        ``seed``, the parameters), then :func:`run_trial`'s measures (those not in the head) with
+        ``plan_time`` as ``time`` and ``gap`` as ``best_gap``, ``n_commands`` and ``commands``
+        (the output plan, as the runner's plan records), ``runtime_s`` (= ``terminate_time_s``),
+        ``error`` (None) and ``version``. With the metric ``"gap"``, :func:`~htetro_opt.studies.runner.run_study`
+        adds ``reference`` (Dijkstra's time over the whole roadmap) and ``gap`` (the output plan's,
+        ``(time − reference) / reference``).
+
+    Raises
+    ------
+    ParameterError
+        If the task is not ``plan``, an option or metric is not one of the trial's, or
+        :func:`run_trial` refuses a value.
+
+    Examples
+    --------
+    >>> record = trial("plan", "three_slit", "htetro-ga", {"pop_size": 12, "max_gen": 5}, 0)
+    >>> record["scenario"], record["label"], record["exact_time"], record["error"], len(record["key"])
+    ('three_slit', 'htetro-ga', 33.0, None, 64)
+    """
+    if task != "plan":
+        raise ParameterError(f"the Table-4 trial plans paths: task must be 'plan', got {task!r}")
+    if label is not None and not isinstance(label, str):
+        raise ParameterError(f"label must be a string or None, got {label!r}")
+    if isinstance(metrics, str) or not isinstance(metrics, Sequence) or \
+            any(m not in STUDY_METRICS for m in metrics):
+        raise ParameterError(f"the Table-4 trial records the metrics {', '.join(STUDY_METRICS)} (its record holds "
+                             f"them whatever the study asks), not others: got {metrics!r}")
+    parameters = _check_trial_parameters(parameters)
+    measured, plan = _measure(scenario, parameters["pop_size"], seed, method=method,
+                              max_gen=parameters.get("max_gen", _PAPER_MAX_GEN),
+                              patience=parameters.get("patience", _PAPER_PATIENCE),
+                              max_length=parameters.get("max_length"))
+    record = Trial(task, scenario, method, parameters, seed, method if label is None else label,
+                   tuple(metrics)).head()
+    for name, value in measured.items():
+        if name in _IN_HEAD:
+            continue
+        record[_RENAMED.get(name, name)] = _plain(value)
+        if name == "plan_time":
+            record["n_commands"] = len(plan.commands) if plan.reached else None
+    record["commands"] = ",".join(plan.tokens)
+    record["runtime_s"] = _plain(plan.runtime_s)
+    record["error"] = None
+    record["version"] = __version__
+    return record
 
 
 # --- the study -----------------------------------------------------------------------------------
-def run_study(
+def table4_study(
     environments: Sequence[str] = ENVIRONMENTS,
     pop_sizes: Sequence[int] = POP_SIZES,
-    seeds: Iterable[int] = range(50),
+    seeds: int | Sequence[int] = 50,
     *,
-    max_gen: int = 1000,
-    patience: int = 100,
+    max_gen: int = _PAPER_MAX_GEN,
+    patience: int = _PAPER_PATIENCE,
     method: str = "htetro-ga",
-    jobs: int = 1,
-    progress: Callable[[int, int, dict], None] | None = None,
-) -> list[dict]:
-    """Every trial of the study: each environment × population size × seed.
+) -> Study:
+    """The Table-4 study for the runner: each environment × population size × seed, l_p,max per
+    :data:`MAX_LENGTH`. With the defaults it is the bundled study ``table4``
+    (``load_study("table4")``); run it with ``run_study(study, trial=trial)``.
 
     Parameters
     ----------
     environments : sequence of str
-        Names from :data:`ENVIRONMENTS`.
+        Names from :data:`ENVIRONMENTS` (a str: one).
     pop_sizes : sequence of int
-    seeds : iterable of int
-        One trial per seed (the paper ran 50).
+        One method entry each, labelled ``"<method>, n_pop <n>"`` (an int: one).
+    seeds : int or sequence of int
+        N for seeds 0 … N−1, or the seeds (the paper ran 50).
     max_gen, patience, method : keyword-only
         As for :func:`run_trial`.
-    jobs : int, keyword-only
-        Worker processes; above 1 the trials run in a :class:`~concurrent.futures.ProcessPoolExecutor`.
-    progress : callable, optional, keyword-only
-        Called as ``progress(done, total, record)`` after each trial, in completion order.
 
     Returns
     -------
-    list of dict
-        :func:`run_trial` records in the order environment, then population size, then seed, as
-        given, whatever ``jobs`` and the completion order.
+    Study
 
     Raises
     ------
     ParameterError
         If an environment is unknown (the message names it), a list is empty, or a number is out of
         range.
-    """
-    if isinstance(environments, str):
-        environments = [environments]
-    environments = [_check_environment(e) for e in environments]
-    pop_sizes = [check_int(n, "pop_size", minimum=2) for n in ([pop_sizes] if isinstance(pop_sizes, int) else pop_sizes)]
-    try:
-        seeds = [check_int(s, "seed", minimum=0) for s in seeds]
-    except TypeError as err:
-        raise ParameterError(f"seeds must be an iterable of integers, got {seeds!r}") from err
-    for name, values in (("environments", environments), ("pop_sizes", pop_sizes), ("seeds", seeds)):
-        if not values:
-            raise ParameterError(f"{name} must not be empty")
-    options = dict(
-        max_gen=check_int(max_gen, "max_gen", minimum=1),
-        patience=check_int(patience, "patience", minimum=1),
-        method=_check_method(method),
-    )
-    jobs = check_int(jobs, "jobs", minimum=1)
-    if progress is not None and not callable(progress):
-        raise ParameterError(f"progress must be callable, got {progress!r}")
 
-    tasks = [(e, n, s, options) for e in environments for n in pop_sizes for s in seeds]
-    results: list[dict | None] = [None] * len(tasks)
-    if jobs == 1 or len(tasks) == 1:
-        for i, task in enumerate(tasks):
-            results[i] = _run_task(task)
-            if progress is not None:
-                progress(i + 1, len(tasks), results[i])
-        return results  # type: ignore[return-value]
-    pool = ProcessPoolExecutor(max_workers=min(jobs, len(tasks)))
-    try:
-        futures = {pool.submit(_run_task, task): i for i, task in enumerate(tasks)}
-        for done, future in enumerate(as_completed(futures), start=1):
-            i = futures[future]
-            results[i] = future.result()
-            if progress is not None:
-                progress(done, len(tasks), results[i])
-    except BaseException:
-        pool.shutdown(wait=True, cancel_futures=True)
-        raise
-    pool.shutdown(wait=True)
-    return results  # type: ignore[return-value]
+    Examples
+    --------
+    >>> study = table4_study(["three_slit"], [12, 25], 2, max_gen=5)
+    >>> [(t.label, t.seed, t.parameters["max_gen"]) for t in study.trials()][:3]
+    [('htetro-ga, n_pop 12', 0, 5), ('htetro-ga, n_pop 12', 1, 5), ('htetro-ga, n_pop 25', 0, 5)]
+    """
+    environments = [_check_environment(e) for e in _check_list(environments, "environments")]
+    pop_sizes = [check_int(n, "pop_size", minimum=2) for n in _check_list(pop_sizes, "pop_sizes")]
+    method = _check_method(method)
+    max_gen = check_int(max_gen, "max_gen", minimum=1)
+    patience = check_int(patience, "patience", minimum=1)
+    common = statistics.mode(MAX_LENGTH.values())  # 100 for the method entry; the spiral's 200 per map
+    per_scenario = {e: {"max_length": MAX_LENGTH[e]} for e in environments if MAX_LENGTH[e] != common}
+    methods = [{"label": f"{method}, n_pop {n}", "method": method, "pop_size": n, "max_gen": max_gen,
+                "patience": patience, "max_length": common, **({"per_scenario": per_scenario} if per_scenario else {})}
+               for n in pop_sizes]
+    return Study(name="table4", task="plan", scenarios=environments, methods=methods,
+                 seeds=seeds if isinstance(seeds, numbers.Integral) else list(_check_list(seeds, "seeds")),
+                 metrics=STUDY_METRICS,
+                 description="Cheng et al. 2020, Table 4: hTetro-GA over six maps and three population sizes")
+
+
+def run_table4(
+    environments: Sequence[str] = ENVIRONMENTS,
+    pop_sizes: Sequence[int] = POP_SIZES,
+    seeds: int | Sequence[int] = 50,
+    *,
+    max_gen: int = _PAPER_MAX_GEN,
+    patience: int = _PAPER_PATIENCE,
+    method: str = "htetro-ga",
+    executor: str = "processes",
+    workers: int | None = None,
+    out: str | os.PathLike | None = None,
+    progress=None,
+) -> StudyRun:
+    """Run :func:`table4_study` on the study runner with :func:`trial`.
+
+    ``executor``, ``workers``, ``out`` and ``progress`` are
+    :func:`~htetro_opt.studies.runner.run_study`'s (``progress(done, total, note)``); the other
+    arguments :func:`table4_study`'s. ``report(run)`` lays the result out as Table 4.
+
+    Returns
+    -------
+    StudyRun
+        Its ``records`` are :func:`trial` records, in the order environment, population size, seed.
+
+    Raises
+    ------
+    ParameterError
+        On an invalid argument, before any trial runs.
+    """
+    study = table4_study(environments, pop_sizes, seeds, max_gen=max_gen, patience=patience, method=method)
+    return run_study(study, out=out, executor=executor, workers=workers, progress=progress, trial=trial)
 
 
 # --- summary -------------------------------------------------------------------------------------
@@ -463,7 +610,8 @@ def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict]:
     Parameters
     ----------
     records : iterable of mapping
-        :func:`run_trial` records (or rows read back by :func:`read_csv`).
+        :func:`trial` records (a :class:`~htetro_opt.studies.runner.StudyRun`'s ``records``, or
+        :func:`~htetro_opt.studies.runner.read_records` of its results file: references are left out).
 
     Returns
     -------
@@ -471,28 +619,31 @@ def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict]:
         Rows in :data:`ENVIRONMENTS` order (others after, by name), then by population size and
         method, with:
 
-        - ``environment``, ``pop_size``, ``method`` (None for records without one), ``runs``,
-          ``reached`` (runs whose output solution has f_gr = 1) and ``reach_rate`` (their fraction);
+        - ``environment`` (the records' ``scenario``), ``pop_size``, ``method``, ``runs``,
+          ``errors`` (trials that raised, recorded with their ``error``), ``reached`` (runs whose
+          output solution has f_gr = 1) and ``reach_rate`` (their fraction of the runs);
         - for each of :data:`TABLE4_COLUMNS` ``<column>_mean`` and ``<column>_std`` (sample standard
           deviation) and the paper's ``paper_<column>_mean`` and ``paper_<column>_std`` (None where
           the paper has no such row). The reach columns are defined only for runs that reached; f_gr,
           the terminate generation and the terminate time are over all runs; f_t, f_sm and f_sf over
           the runs that reached (a failed run's output solution is not a path to the goal);
         - ``best_time_mean``, ``best_time_std``, ``exact_time_mean``, ``exact_time_min``,
-          ``exact_time_max``, ``gap_mean``, ``gap_max``, ``f_t_gap_mean``, ``f_t_gap_max`` and
-          ``plan_time_mean`` (each over the runs where it is defined).
+          ``exact_time_max``, ``best_gap_mean``, ``best_gap_max``, ``f_t_gap_mean``, ``f_t_gap_max``
+          and ``time_mean`` (the output plan's; each over the runs where it is defined).
 
     Examples
     --------
     >>> rows = summarise([
-    ...     {"environment": "random", "pop_size": 25, "f_gr": 1.0, "f_t": 0.6, "terminate_generation": 10},
-    ...     {"environment": "random", "pop_size": 25, "f_gr": 0.5, "f_t": 0.9, "terminate_generation": 30},
+    ...     {"scenario": "random", "pop_size": 25, "f_gr": 1.0, "f_t": 0.6, "terminate_generation": 10},
+    ...     {"scenario": "random", "pop_size": 25, "f_gr": 0.5, "f_t": 0.9, "terminate_generation": 30},
     ... ])
     >>> rows[0]["reach_rate"], rows[0]["f_t_mean"], rows[0]["terminate_generation_mean"]
     (0.5, 0.6, 20.0)
     """
-    records = list(records)
-    groups = group_records(records, ["environment", "pop_size", "method"])
+    if isinstance(records, (str, Mapping)) or not isinstance(records, Iterable):
+        raise ParameterError(f"records must be an iterable of trial records (dicts), got {records!r}")
+    records = [r for r in records if r.get("kind", "trial") != "reference"]
+    groups = group_records(records, ["scenario", "pop_size", "method"])
     over_reached = {"f_t", "f_sm", "f_sf"}
     rows = []
     for key in sorted(groups, key=_order):
@@ -504,6 +655,7 @@ def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict]:
             "pop_size": pop_size,
             "method": method,
             "runs": len(group),
+            "errors": sum(r.get("error") is not None for r in group),
             "reached": reached,
             "reach_rate": reached / len(group),
         }
@@ -517,11 +669,11 @@ def summarise(records: Iterable[Mapping[str, Any]]) -> list[dict]:
         row["exact_time_mean"] = mean_std(exact)[0]
         row["exact_time_min"] = min(exact) if exact else None
         row["exact_time_max"] = max(exact) if exact else None
-        for name in ("gap", "f_t_gap"):
+        for name in ("best_gap", "f_t_gap"):
             values = values_of(group, name)
             row[f"{name}_mean"] = mean_std(values)[0]
             row[f"{name}_max"] = max(values) if values else None
-        row["plan_time_mean"] = mean_std(values_of(group, "plan_time"))[0]
+        row["time_mean"] = mean_std(values_of(group, "time"))[0]
         rows.append(row)
     return rows
 
@@ -546,32 +698,34 @@ def _number(value: float | None, digits: int = 1) -> str:
 def markdown_table(summary: Iterable[Mapping[str, Any]]) -> str:
     """A markdown table of :func:`summarise` rows: ours as "mean ± std", the paper's in brackets.
 
-    Columns: environment, n_pop, the method (only when the rows hold more than one), runs, reached
-    (of runs), reach and terminate generation, reach and
+    Columns: environment, n_pop, the method (only when the rows hold more than one), runs, errors
+    (only when some trial raised), reached (of runs), reach and terminate generation, reach and
     terminate time, f_t, f_sm, f_sf (each "ours (paper)"), the exact optimum time, the best GA time
     (mean ± std over the runs that reached) and the gap of the best GA time to the optimum (mean, and
     the largest in brackets).
 
     Examples
     --------
-    >>> text = markdown_table(summarise([{"environment": "three_slit", "pop_size": 50, "f_gr": 1.0,
-    ...     "reach_generation": 200, "best_time": 36.0, "exact_time": 33.0, "gap": 3 / 33}]))
+    >>> text = markdown_table(summarise([{"scenario": "three_slit", "pop_size": 50, "f_gr": 1.0,
+    ...     "reach_generation": 200, "best_time": 36.0, "exact_time": 33.0, "best_gap": 3 / 33}]))
     >>> "| three_slit | 50 | 1 | 1/1 | 200.00 (210.60 ± 27.56) |" in text
     True
     """
     summary = list(summary)
     several = len({row.get("method") for row in summary}) > 1
-    header = ["environment", "n_pop"] + (["method"] if several else []) + ["runs", "reached"]
+    errors = any(row.get("errors") for row in summary)
+    header = (["environment", "n_pop"] + (["method"] if several else []) + ["runs"]
+              + (["errors"] if errors else []) + ["reached"])
     lead = len(header)
     header += [f"{label}, ours (paper)" for _, label, _ in _MD_COLUMNS]
     header += ["exact optimum", "best GA time", "gap to optimum"]
-    lines = ["| " + " | ".join(header) + " |",
-             "|" + "|".join(["---", "---:"] + (["---"] if several else []) + ["---:"] * (len(header) - 2 - several))
-             + "|"]
+    aligns = ["---", "---:"] + (["---"] if several else []) + ["---:"] * (len(header) - 2 - several)
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join(aligns) + "|"]
     for row in summary:
         cells = [str(row["environment"]), str(row["pop_size"])]
         cells += [str(row.get("method"))] if several else []
-        cells += [str(row["runs"]), f"{row['reached']}/{row['runs']}"]
+        cells += [str(row["runs"])] + ([str(row.get("errors", 0))] if errors else [])
+        cells += [f"{row['reached']}/{row['runs']}"]
         assert len(cells) == lead
         for column, _, digits in _MD_COLUMNS:
             ours = format_mean_std(row.get(f"{column}_mean"), row.get(f"{column}_std"), digits=digits)
@@ -581,93 +735,27 @@ def markdown_table(summary: Iterable[Mapping[str, Any]]) -> str:
         lo, hi = row.get("exact_time_min"), row.get("exact_time_max")
         cells.append(_number(lo) if lo == hi else f"{_number(lo)}–{_number(hi)}")
         cells.append(format_mean_std(row.get("best_time_mean"), row.get("best_time_std"), digits=1))
-        gap_mean, gap_max = row.get("gap_mean"), row.get("gap_max")
+        gap_mean, gap_max = row.get("best_gap_mean"), row.get("best_gap_max")
         cells.append("–" if gap_mean is None else f"{100 * gap_mean:.1f} % (max {100 * gap_max:.1f} %)")
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
 
-# --- files ---------------------------------------------------------------------------------------
-def _write_atomic(path: str | os.PathLike, text: str) -> Path:
-    """Write ``text`` to ``path`` so that the path never holds a half-written file."""
-    with atomic_path(path) as tmp:
-        with open(tmp, "w", encoding="utf-8", newline="") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-    return Path(path)
-
-
-def _csv_value(value: Any) -> str:
-    if value is None:
-        return ""
-    if isinstance(value, (float, np.floating)):
-        return repr(float(value))
-    return str(value)
-
-
-def write_csv(records: Iterable[Mapping[str, Any]], path: str | os.PathLike) -> Path:
-    """Write one CSV line per trial record, atomically.
-
-    Columns are :data:`RECORD_FIELDS` then any other keys in order of first appearance; None is
-    written as an empty cell, floats at full precision.
-
-    Returns
-    -------
-    Path
-        The path written.
+def report(run: StudyRun) -> str:
+    """The Markdown Table 4 of a run of the Table-4 study: ours beside the paper's, the exact optimum
+    and the gap (:func:`markdown_table` of :func:`summarise`).
 
     Raises
     ------
-    OSError
-        If the file cannot be written (the directory must exist); nothing is left behind.
-    """
-    records = list(records)
-    fields = list(RECORD_FIELDS)
-    for record in records:
-        fields += [k for k in record if k not in fields]
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(fields)
-    for record in records:
-        writer.writerow([_csv_value(record.get(k)) for k in fields])
-    return _write_atomic(path, buffer.getvalue())
-
-
-def read_csv(path: str | os.PathLike) -> list[dict]:
-    """Read back the records of :func:`write_csv`, with their types (empty cells → None).
-
-    Raises
-    ------
-    OSError
-        If the file cannot be read.
     ParameterError
-        If a cell does not parse as its column's type.
+        If ``run`` is not a :class:`~htetro_opt.studies.runner.StudyRun`, or its records are not
+        :func:`trial`'s (the study was run without ``trial=table4.trial``).
     """
-    out = []
-    with open(path, newline="", encoding="utf-8") as handle:
-        for line, raw in enumerate(csv.DictReader(handle), start=2):
-            record: dict[str, Any] = {}
-            for key, text in raw.items():
-                try:
-                    if text == "" or text is None:
-                        record[key] = None
-                    elif key in _STR_FIELDS:
-                        record[key] = text
-                    elif key in _BOOL_FIELDS:
-                        if text not in ("True", "False"):
-                            raise ValueError(text)
-                        record[key] = text == "True"
-                    elif key in _INT_FIELDS:
-                        record[key] = int(text)
-                    elif key in RECORD_FIELDS:
-                        record[key] = float(text)
-                    else:
-                        record[key] = text
-                except ValueError as err:
-                    raise ParameterError(f"{path}, line {line}: bad {key} value {text!r}") from err
-            out.append(record)
-    return out
-
-
-# --- command line --------------------------------------------------------------------------------
+    if not isinstance(run, StudyRun):
+        raise ParameterError(f"run must be the StudyRun of run_study, got {run!r}")
+    foreign = [r for r in run.records if r.get("error") is None and "terminate_generation" not in r]
+    if foreign:
+        raise ParameterError(f"the records of study {run.study.name!r} are not Table-4 trials (e.g. "
+                             f"{foreign[0].get('scenario')} {foreign[0].get('label')}): run it with "
+                             "run_study(..., trial=htetro_opt.studies.table4.trial)")
+    return markdown_table(summarise(run.records))

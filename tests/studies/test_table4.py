@@ -1,7 +1,7 @@
-"""The Table-4 study: the paper's numbers, one trial's record, the aggregation, the files and the CLI."""
+"""The Table-4 study: the paper's numbers, one trial's record, the trial on the study runner (executors,
+resume, errors), the aggregation and the report."""
 
 import math
-import os
 import re
 
 import pytest
@@ -9,7 +9,14 @@ import pytest
 from htetro_opt.errors import ParameterError
 from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers.grid_paths import plan_exact
-from htetro_opt.studies import format_mean_std, mean_std, table4, values_of
+from htetro_opt.studies import format_mean_std, mean_std, values_of
+from htetro_opt.studies.runner import (
+    RUNTIME_FIELDS,
+    Study,
+    load_study,
+    read_records,
+    run_study,
+)
 from htetro_opt.studies.table4 import (
     ENVIRONMENTS,
     MAX_LENGTH,
@@ -18,11 +25,12 @@ from htetro_opt.studies.table4 import (
     TABLE4_COLUMNS,
     TIME_FIELDS,
     markdown_table,
-    read_csv,
-    run_study,
+    report,
+    run_table4,
     run_trial,
     summarise,
-    write_csv,
+    table4_study,
+    trial,
 )
 
 # Table 4 as it reads in the text of Cheng et al. 2020 (IEEE Access 8), its 18 rows copied verbatim,
@@ -48,6 +56,23 @@ PAPER_TABLE4_TEXT = (
     'Dynamic\t$n_{pop} = 50$\t6.66 ± 3.74\t23.56 ± 3.48\t6.92 ± 1.36\t19.88 ± 2.99\t1.000 ± 0.000\t0.531 ± 0.037\t0.494 ± 0.068\t0.167 ± 0.018\n'
     '•\t$n_{\\text{pop}}^{\\text{r-r}} = 100$\t4.82 ± 0.96\t24.00 ± 4.96\t9.92 ± 1.49\t34.82 ± 7.40\t1.000 ± 0.000\t0.537 ± 0.078\t$0.491 \\pm\\ 0.081$\t0.171 ± 0.016\n'
 )
+
+
+# A run_trial field under its name in a runner record (the runner owns "gap"; "time" is its name for
+# the output plan's time; the head holds the environment as "scenario").
+RENAMED = {"environment": "scenario", "plan_time": "time", "gap": "best_gap"}
+TINY = {"environments": ["three_slit", "random"], "pop_sizes": [12, 25], "seeds": 2, "max_gen": 20}
+
+
+def _content(records):
+    """Records without their wall-clock fields."""
+    return [{k: v for k, v in r.items() if k not in TIME_FIELDS} for r in records]
+
+
+@pytest.fixture(scope="module")
+def serial(tmp_path_factory):
+    """The tiny Table-4 study run serially into a results folder."""
+    return run_table4(**TINY, executor="serial", out=tmp_path_factory.mktemp("table4"))
 
 
 # --- the paper's table ---------------------------------------------------------------------------
@@ -81,7 +106,8 @@ def test_paper_table_matches_the_text_everywhere():
 
 
 def test_max_length_follows_the_paper():
-    assert set(TIME_FIELDS) <= set(RECORD_FIELDS)
+    assert {"reach_time_s", "terminate_time_s"} <= set(RECORD_FIELDS)
+    assert set(RUNTIME_FIELDS) <= set(TIME_FIELDS)  # the runner's wall-clock fields are ours too
     assert MAX_LENGTH == {e: 200 if e == "spiral" else 100 for e in ENVIRONMENTS}
 
 
@@ -122,55 +148,169 @@ def test_failed_multi_leg_trial_still_has_the_exact_reference():
 def test_run_trial_is_deterministic_and_validates():
     a = run_trial("three_slit", 12, 3, max_gen=5)
     b = run_trial("three_slit", 12, 3, max_gen=5)
-    assert {k: v for k, v in a.items() if k not in TIME_FIELDS} == {
-        k: v for k, v in b.items() if k not in TIME_FIELDS}
+    assert _content([a]) == _content([b])
+    assert run_trial("three_slit", 12, 3, max_gen=5, max_length=60)["max_length"] == 60
     with pytest.raises(ParameterError, match="maze"):
         run_trial("maze", 25, 0)
     with pytest.raises(ParameterError, match="pop_size"):
         run_trial("random", 1, 0)
+    with pytest.raises(ParameterError, match="max_length"):
+        run_trial("random", 25, 0, max_length=0)
     with pytest.raises(ParameterError, match="method"):
         run_trial("random", 25, 0, method="pso")
     with pytest.raises(ParameterError, match="method"):
         run_trial("random", 25, 0, method="htetro")  # the old name: refused, not silently mapped
 
 
-def test_run_study_validates_before_running():
+# --- the trial on the study runner ---------------------------------------------------------------
+def test_bundled_study_is_table4_study():
+    assert table4_study() == load_study("table4")  # the study file and the Python study agree
+    small = table4_study(["spiral", "three_slit"], 25, [4, 7], max_gen=9, patience=3, method="htetro-ga-paper")
+    assert [(t.scenario, t.seed, t.parameters) for t in small.trials()] == [
+        (s, seed, {"max_gen": 9, "max_length": MAX_LENGTH[s], "patience": 3, "pop_size": 25})
+        for s in ("spiral", "three_slit") for seed in (4, 7)]
+    assert {t.method for t in small.trials()} == {"htetro-ga-paper"}
     with pytest.raises(ParameterError, match="'nowhere'"):
-        run_study(["three_slit", "nowhere"], [12], range(1))
+        table4_study(["three_slit", "nowhere"])
+    with pytest.raises(ParameterError, match="pop_sizes"):
+        table4_study(pop_sizes=[])
     with pytest.raises(ParameterError, match="seeds"):
-        run_study(["three_slit"], [12], [])
-    with pytest.raises(ParameterError, match="jobs"):
-        run_study(["three_slit"], [12], range(1), jobs=0)
+        run_table4(["three_slit"], [12], [])
+    with pytest.raises(ParameterError, match="workers"):
+        run_table4(["three_slit"], [12], 1, executor="serial", workers=2)
 
 
-def test_parallel_study_gives_the_same_records():
-    calls = []
-    serial = run_study(["three_slit"], [12], range(2), max_gen=5)
-    parallel = run_study(["three_slit"], [12], range(2), max_gen=5, jobs=2,
-                         progress=lambda done, total, record: calls.append((done, total)))
-    assert [r["seed"] for r in parallel] == [0, 1]
-    strip = lambda rs: [{k: v for k, v in r.items() if k not in TIME_FIELDS} for r in rs]
-    assert strip(serial) == strip(parallel)
-    assert sorted(calls) == [(1, 2), (2, 2)]
+def test_runner_records_are_run_trials(serial):
+    study = table4_study(**TINY)
+    records = serial.records
+    assert [r["key"] for r in records] == [t.key for t in study.trials()]
+    assert [(r["scenario"], r["pop_size"], r["seed"]) for r in records] == [
+        (e, n, s) for e in ("three_slit", "random") for n in (12, 25) for s in (0, 1)]
+    for record in records:
+        assert record["error"] is None and record["label"] == f"htetro-ga, n_pop {record['pop_size']}"
+        direct = run_trial(record["scenario"], record["pop_size"], record["seed"], max_gen=20)
+        assert {k: v for k, v in _content([direct])[0].items()} == {
+            k: record[RENAMED.get(k, k)] for k in _content([direct])[0]}
+        # the runner's reference is the exact optimum (oracle: plan_exact), its gap the output plan's
+        scenario = load_scenario(record["scenario"])
+        optimum = plan_exact(scenario.workspace, scenario.roadmap).time
+        assert record["reference"] == optimum
+        if record["reached"]:
+            assert record["gap"] == pytest.approx((record["time"] - optimum) / optimum)
+            assert record["n_commands"] == len(record["commands"].split(","))
+        else:
+            assert record["gap"] is None and record["time"] is None
+    assert any(r["reached"] for r in records) and any(r["best_gap"] for r in records)  # both cases ran
+    assert [r["scenario"] for r in serial.references] == ["three_slit", "random"]
+
+
+def test_trial_key_is_the_runner_trial_key():
+    study = table4_study(["three_slit"], [12], [5], max_gen=3)
+    (t,) = study.trials()
+    record = trial(t.task, t.scenario, t.method, t.parameters, t.seed, label=t.label, metrics=t.metrics)
+    assert record["key"] == t.key and record["seed"] == 5 and record["max_gen"] == 3
+
+
+def test_trial_validates():
+    good = {"pop_size": 12, "max_gen": 3}
+    with pytest.raises(ParameterError, match="task"):
+        trial("tile", "three_slit", "htetro-ga", good, 0)
+    with pytest.raises(ParameterError, match="'clearance'"):
+        trial("plan", "three_slit", "htetro-ga", {**good, "clearance": 1.0}, 0)
+    with pytest.raises(ParameterError, match="pop_size"):
+        trial("plan", "three_slit", "htetro-ga", {"max_gen": 3}, 0)
+    with pytest.raises(ParameterError, match="maze"):
+        trial("plan", "maze", "htetro-ga", good, 0)
+    with pytest.raises(ParameterError, match="metrics"):
+        trial("plan", "three_slit", "htetro-ga", good, 0, metrics=["speed"])
+    with pytest.raises(ParameterError, match="'front'"):  # a runner metric the Table-4 record does not hold
+        trial("plan", "three_slit", "htetro-ga", good, 0, metrics=["gap", "front"])
+    with pytest.raises(ParameterError, match="seed"):
+        trial("plan", "three_slit", "htetro-ga", good, None)
+
+
+def test_executors_give_the_same_records(serial):
+    processes = run_table4(**TINY, executor="processes", workers=2)
+    assert _content(processes.records) == _content(serial.records)
+    assert _content(processes.references) == _content(serial.references)
+
+
+def test_resume_runs_only_what_is_missing(serial, tmp_path):
+    lines = serial.path.read_text(encoding="utf-8").splitlines(keepends=True)
+    assert len(lines) == 2 + 8  # the two maps' references, then the trials
+    path = tmp_path / serial.path.name
+    path.write_text("".join(lines[:5]) + lines[5][:40], encoding="utf-8")  # killed while writing line 6
+    study = table4_study(**TINY)
+    run = run_study(study, trial=trial, out=tmp_path, resume=True, executor="processes", workers=2)
+    assert run.resumed == 5 and run.failed == 0
+    assert _content(run.records) == _content(serial.records)
+    assert sorted(r["key"] for r in read_records(path)) == sorted(r["key"] for r in read_records(serial.path))
+    again = run_study(study, trial=trial, out=tmp_path, resume=True, executor="serial")
+    assert again.resumed == 10 and len(read_records(path)) == 10  # nothing left to run
+
+
+def test_report_puts_ours_beside_the_papers(serial):
+    text = report(serial)
+    lines = text.splitlines()
+    assert lines[0].startswith("| environment | n_pop | runs | reached | reach gen, ours (paper) |")
+    assert [line.split(" | ")[:2] for line in lines[2:]] == [  # in the paper's row order
+        ["| random", "12"], ["| random", "25"], ["| three_slit", "12"], ["| three_slit", "25"]]
+    slit25 = lines[5]
+    assert "(374.02 ± 35.17) |" in slit25 and "(0.444 ± 0.027) |" in slit25  # the paper's, n_pop 25
+    assert "(–) |" in lines[4]  # the paper has no n_pop 12
+    assert " | 33 | " in slit25 and " | 36 | " in lines[3]  # the exact optima
+    reached = [r for r in serial.records if r["scenario"] == "random" and r["pop_size"] == 12 and r["reached"]]
+    gaps = [100 * r["best_gap"] for r in reached]
+    assert lines[2].endswith(f"| {sum(gaps) / len(gaps):.1f} % (max {max(gaps):.1f} %) |")
+    # the results file holds the references too: the summary leaves them out
+    assert summarise(read_records(serial.path)) == summarise(serial.records)
+    assert text == markdown_table(summarise(serial.records))
+
+
+def test_report_refuses_records_of_another_trial():
+    generic = run_study(table4_study(["three_slit"], [12], 1, max_gen=3), executor="serial")  # no trial=
+    with pytest.raises(ParameterError, match="trial=htetro_opt.studies.table4.trial"):
+        report(generic)
+    with pytest.raises(ParameterError, match="StudyRun"):
+        report(generic.records)
+
+
+def test_errors_are_recorded_and_counted():
+    study = Study(name="t4-errors", task="plan", scenarios=["three_slit", "maze"], seeds=1, metrics=["gap"],
+                  methods=[{"method": "htetro-ga", "pop_size": 12, "max_gen": 3}])
+    run = run_study(study, trial=trial, executor="serial")
+    slit, maze = run.records
+    assert slit["error"] is None
+    assert maze["error"].startswith("ParameterError: unknown environment 'maze'")
+    rows = summarise(run.records)
+    assert [(r["environment"], r["runs"], r["errors"], r["reached"]) for r in rows] == [
+        ("three_slit", 1, 0, 0), ("maze", 1, 1, 0)]
+    lines = report(run).splitlines()
+    assert lines[0].startswith("| environment | n_pop | runs | errors | reached |")
+    assert lines[3].startswith("| maze | 12 | 1 | 1 | 0/1 | – (–) |")
+    assert len({line.count("|") for line in lines}) == 1
 
 
 # --- aggregation ---------------------------------------------------------------------------------
 def _synthetic():
-    base = dict(method="htetro-ga", max_gen=1000, patience=100, max_length=100, legs=1, legs_run=1,
-                exact_time=33.0, f_gr=1.0, reached=True, f_sm=0.5, f_sf=0.25)
+    base = dict(kind="trial", task="plan", method="htetro-ga", max_gen=1000, patience=100, max_length=100, legs=1,
+                legs_run=1, exact_time=33.0, f_gr=1.0, reached=True, f_sm=0.5, f_sf=0.25, error=None)
     rows = [
-        dict(base, environment="three_slit", pop_size=50, seed=0, reach_generation=100,
+        dict(base, scenario="three_slit", pop_size=50, seed=0, reach_generation=100,
              terminate_generation=200, reach_time_s=1.0, terminate_time_s=2.0, f_t=0.6,
-             best_time=36.0, gap=3 / 33, plan_time=40.0),
-        dict(base, environment="three_slit", pop_size=50, seed=1, reach_generation=300,
+             best_time=36.0, best_gap=3 / 33, time=40.0),
+        dict(base, scenario="three_slit", pop_size=50, seed=1, reach_generation=300,
              terminate_generation=400, reach_time_s=3.0, terminate_time_s=4.0, f_t=0.7,
-             best_time=33.0, gap=0.0, plan_time=33.0),
-        dict(base, environment="three_slit", pop_size=50, seed=2, reached=False, f_gr=0.5, f_t=0.9,
+             best_time=33.0, best_gap=0.0, time=33.0),
+        dict(base, scenario="three_slit", pop_size=50, seed=2, reached=False, f_gr=0.5, f_t=0.9,
              reach_generation=None, reach_time_s=None, terminate_generation=1000, terminate_time_s=9.0,
-             best_time=None, gap=None, plan_time=None),
-        dict(base, environment="random", pop_size=25, seed=0, reach_generation=3, terminate_generation=30,
-             reach_time_s=0.5, terminate_time_s=1.5, f_t=0.64, best_time=36.0, exact_time=36.0, gap=0.0,
-             plan_time=36.0),
+             best_time=None, best_gap=None, time=None),
+        dict(base, scenario="random", pop_size=25, seed=0, reach_generation=3, terminate_generation=30,
+             reach_time_s=0.5, terminate_time_s=1.5, f_t=0.64, best_time=36.0, exact_time=36.0, best_gap=0.0,
+             time=36.0),
+        # a reference of the results file: left out
+        dict(kind="reference", task="plan", scenario="three_slit", method="dijkstra", label="reference", seed=None,
+             reached=True, time=33.0, error=None),
     ]
     return rows
 
@@ -190,7 +330,7 @@ def test_summarise_synthetic():
     rows = summarise(_synthetic())
     assert [(r["environment"], r["pop_size"]) for r in rows] == [("random", 25), ("three_slit", 50)]
     slit = rows[1]
-    assert (slit["runs"], slit["reached"]) == (3, 2)
+    assert (slit["runs"], slit["errors"], slit["reached"]) == (3, 0, 2)
     assert math.isclose(slit["reach_rate"], 2 / 3)
     assert (slit["reach_generation_mean"], slit["reach_generation_std"]) == (200.0, pytest.approx(math.sqrt(2) * 100))
     assert slit["terminate_generation_mean"] == pytest.approx(1600 / 3)  # failed runs count for the cost
@@ -199,15 +339,18 @@ def test_summarise_synthetic():
     assert slit["f_t_mean"] == pytest.approx(0.65)  # quality over the runs that reached
     assert slit["f_t_std"] == pytest.approx(math.sqrt(0.005))
     assert slit["best_time_mean"] == 34.5 and slit["exact_time_mean"] == 33.0
-    assert slit["gap_mean"] == pytest.approx(1.5 / 33) and slit["gap_max"] == pytest.approx(3 / 33)
+    assert slit["best_gap_mean"] == pytest.approx(1.5 / 33) and slit["best_gap_max"] == pytest.approx(3 / 33)
+    assert slit["time_mean"] == 36.5
     assert (slit["paper_reach_generation_mean"], slit["paper_reach_generation_std"]) == (210.60, 27.56)
     assert rows[0]["reach_generation_std"] is None  # one run: no spread
     assert slit["method"] == "htetro-ga"
-    unknown = summarise([dict(_synthetic()[0], environment="maze")])
+    unknown = summarise([dict(_synthetic()[0], scenario="maze")])
     assert unknown[0]["paper_f_t_mean"] is None
     mixed = summarise(_synthetic() + [dict(_synthetic()[0], method="nsga2")])
     assert [(r["environment"], r["method"], r["runs"]) for r in mixed] == [
         ("random", "htetro-ga", 1), ("three_slit", "htetro-ga", 3), ("three_slit", "nsga2", 1)]
+    with pytest.raises(ParameterError, match="records"):
+        summarise({"scenario": "random"})
 
 
 def test_markdown_table_synthetic():
@@ -227,36 +370,13 @@ def test_markdown_table_synthetic():
     assert len({line.count("|") for line in mixed}) == 1
 
 
-def test_write_and_read_csv(tmp_path):
-    records = _synthetic()
-    path = write_csv(records, tmp_path / "t.csv")
-    lines = path.read_text().splitlines()
-    assert lines[0].split(",") == list(RECORD_FIELDS)
-    assert len(lines) == 1 + len(records)
-    back = read_csv(path)
-    assert [{k: r.get(k) for k in RECORD_FIELDS} for r in records] == back
-    assert os.listdir(tmp_path) == ["t.csv"]
-
-
-def test_writes_are_atomic(tmp_path, monkeypatch):
-    path = tmp_path / "t.csv"
-    path.write_text("old\n")
-
-    def broken(src, dst):
-        raise OSError("disk full")
-
-    monkeypatch.setattr(table4.os, "replace", broken)
-    with pytest.raises(OSError, match="disk full"):
-        write_csv(_synthetic(), path)
-    assert path.read_text() == "old\n"
-    assert os.listdir(tmp_path) == ["t.csv"]  # no temporary file left behind
-
-
 @pytest.mark.slow
-@pytest.mark.parametrize("environment, optimum", [("three_slit", 33.0), ("perpendicular_dynamic", 36.0)])
-def test_reaches_with_the_paper_budget(environment, optimum):
+@pytest.mark.parametrize("environment, optima", [("three_slit", {33.0}), ("perpendicular_dynamic", {34.0, 35.0, 36.0})])
+def test_reaches_with_the_paper_budget(environment, optima):
+    # On the 3-leg perpendicular_dynamic map the exact reference is per leg at the GA leg's clock: a leg
+    # started later can be cheaper than on plan_exact's own chain (36), hence 34–36 (benchmarks/README.md).
     record = run_trial(environment, 50, 0, max_gen=300)
     assert record["reached"] and record["f_gr"] == 1.0
-    assert record["best_time"] >= record["exact_time"] == optimum
+    assert record["exact_time"] in optima and record["best_time"] >= record["exact_time"]
     assert record["gap"] >= 0.0 and record["f_t_gap"] >= 0.0
     assert record["reach_generation"] <= record["terminate_generation"]
