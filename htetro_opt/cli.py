@@ -169,7 +169,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", metavar="DIR", help="write DIR/NAME.jsonl (every trial), DIR/NAME.csv and DIR/NAME.md")
     p.add_argument("--resume", action="store_true", help="skip the trials already recorded in DIR/NAME.jsonl")
     p.add_argument("--retries", type=int, default=0, help="re-run a failing trial up to N times (default 0)")
-    p.add_argument("--time-limit", type=float, help="seed003 only: cap in seconds for each method that takes one")
+    p.add_argument("--time-limit", type=float,
+                   help="seed003 only: cap in seconds for each method that takes one (a study file sets its own)")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the summary table")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
     return parser
@@ -585,7 +586,7 @@ def _study_folder(out: str | None) -> Path | None:
 
 def _cmd_study(args) -> dict:
     if args.study == "seed003":
-        return _legacy_seed003(args)
+        return _seed003(args)
     from htetro_opt.studies.runner import load_study, run_study
 
     if args.time_limit is not None:
@@ -621,32 +622,31 @@ def _cmd_study(args) -> dict:
     return run.as_dict()
 
 
-def _legacy_seed003(args) -> dict:
-    """Le et al. 2018's Tables 1–5 beside the paper's (not on the study runner yet)."""
+def _seed003(args) -> dict:
+    """Le et al. 2018's Tables 1–5 beside the paper's: Tables 1, 2, 4 and 5 on the study runner, Table 3
+    (tilings shuffled by seed, which a sequencing study cannot express) in this process."""
     from htetro_opt.studies import seed003
 
-    for flag, value in (("--executor", args.executor != "processes"), ("--workers", args.workers),
-                        ("--scheduler", args.scheduler), ("--resume", args.resume), ("--retries", args.retries)):
-        if value:
-            raise ParameterError(f"{flag} does not apply to seed003, which runs in this process")
-    seeds = check_int(5 if args.seeds is None else args.seeds, "--seeds", minimum=1)
+    if args.scheduler:
+        raise ParameterError("--scheduler does not apply to seed003 (processes or serial)")
+    if args.executor == "dask":
+        raise ParameterError("--executor dask does not apply to seed003 (processes or serial)")
+    if args.resume and not args.out:
+        raise ParameterError("--resume needs --out DIR, the folder holding the study's results")
+    seeds = list(range(check_int(5 if args.seeds is None else args.seeds, "--seeds", minimum=1)))
     time_limit = _cli_time_limit(args.time_limit)
+    workers = check_int(args.workers, "--workers", minimum=1, allow_none=True)
     out = _study_folder(args.out)
-    with _console(args).step("seed003 study") as progress:
-        records = seed003.run_study(seeds=range(seeds), time_limit=time_limit,
-                                    progress=lambda message: progress(0, None, message))
-    text = seed003.markdown_report(records) + "\n"
-    result = {"study": "seed003", "records": records, "out": None if out is None else str(out)}
+    console = _console(args)
+    with console.step("seed003 study", 1, "trials") as progress:
+        run = seed003.run_seed003(seeds, time_limit=time_limit, executor=args.executor, workers=workers,
+                                  out=out, resume=args.resume, progress=progress)
+    with console.step("seed003 Table 3 (our tilings)"):
+        table3 = seed003.run_table3(seeds=seeds[:2])  # two seeds, as the study always ran it
+    text = seed003.report(run, table3=table3) + "\n"
+    result = {**run.as_dict(), "table3": table3}
     if out is not None:
-        def write_all() -> None:
-            try:
-                out.mkdir(parents=True, exist_ok=True)
-            except OSError as err:
-                raise OutputError(f"cannot create the study folder {str(out)!r}: {err.strerror or err}") from err
-            seed003.write_csv(records, out / "seed003.csv")
-            write_text(out / "seed003.md", text, what="study report")
-
-        _late(result, write_all)
+        _late(result, lambda: write_text(out / "seed003_paper.md", text, what="study report"))
     if not args.json:
         print(text, end="")
     return result

@@ -962,3 +962,16 @@ def test_study_table4_prints_ours_beside_the_papers(capsys, tmp_path):
     assert "| three_slit | 12 |" in out and "exact optimum" in out
     report = (out_dir / "table4_paper.md").read_text().strip()
     assert report.startswith("| environment") and report in out
+
+
+def test_study_seed003_runs_on_the_runner_and_resumes(capsys, tmp_path):
+    out_dir = tmp_path / "out"
+    argv = ["study", "seed003", "--seeds", "1", "--time-limit", "0.5", "--out", str(out_dir)]
+    code, out, err = run(capsys, argv)
+    assert code == 0, err
+    assert out.count("### Table") >= 5 and "Exact (CP-SAT)" in out
+    assert sorted(p.name for p in out_dir.iterdir()) == ["seed003.csv", "seed003.jsonl", "seed003.md",
+                                                         "seed003_paper.md"]
+    lines = (out_dir / "seed003.jsonl").read_text().splitlines()
+    again = run_json(capsys, [*argv, "--resume", "--json"])  # nothing left to run: the same records
+    assert again["trials"] == len(again["records"]) and (out_dir / "seed003.jsonl").read_text().splitlines() == lines

@@ -17,7 +17,19 @@ adds what the paper could not report: each method's gap to the proven optimum (t
 The paper's numbers sit beside ours (``PAPER_*``). Its tables do not say from which tile its paths
 start; ours start from tile 1, as its figures' paths do.
 
-Run from the command line::
+On the study runner (:mod:`htetro_opt.studies.runner`), Tables 1 and 2 are the bundled study
+``seed003`` (``studies/data/seed003.toml``, or :func:`seed003_study`), run by the runner's own
+``sequence`` trial; :func:`report` lays its records out as today's tables, deriving Table 2's
+equal-weight prices and Tables 4–5's coverage simulation from the recorded orders (both are
+deterministic given an order). Table 3 tiles with a shuffle drawn from a seed, which the runner's
+``sequence`` task does not do: it stays :func:`run_table3`, passed to :func:`report`::
+
+    from htetro_opt.studies import seed003
+
+    run = seed003.run_seed003(seeds=5, out="results")        # or run_study(load_study("seed003"))
+    print(seed003.report(run, table3=seed003.run_table3(seeds=range(2))))
+
+The command line still runs the in-process path::
 
     htetro-opt study seed003 --seeds 5 --out DIR
 
@@ -29,18 +41,23 @@ from __future__ import annotations
 
 import csv
 import io
-from collections.abc import Iterable, Sequence
+import numbers
+import os
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 from htetro_opt._files import atomic_path
 from htetro_opt._validation import check_int, check_time_limit
 from htetro_opt.errors import ParameterError, TilingError
 from htetro_opt.model.coverage import simulate_coverage
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, path_cost
-from htetro_opt.scenarios import Tileset, load_scenario, load_tileset, tileset_path
+from htetro_opt.scenarios import Tileset, list_scenarios, list_tilesets, load_scenario, load_tileset, tileset_path
 from htetro_opt.solvers.sequencing import sequence_waypoints
 from htetro_opt.solvers.tiling import tile_workspace
 from htetro_opt.studies.metrics import format_mean_std, mean_std
+from htetro_opt.studies.runner import Study, StudyRun
+from htetro_opt.studies.runner import run_study as run_runner_study
 
 __all__ = [
     "PAPER_TABLE1",
@@ -51,7 +68,12 @@ __all__ = [
     "PAPER_TILESETS",
     "paper_tileset",
     "TABLE1_METHODS",
+    "TABLE1_SCENARIOS",
+    "TABLE2_SCENARIOS",
     "STOCHASTIC",
+    "seed003_study",
+    "run_seed003",
+    "report",
     "run_table1",
     "run_table2",
     "run_table3",
@@ -71,6 +93,10 @@ PAPER_TABLE1 = {  # method: (cost weight, path generating time s), 11 x 11, 28 w
 }
 TABLE1_METHODS = ("zigzag", "zigzag2", "spiral", "spiral2", "greedy", "ga-plain", "ga", "ortools", "local", "exact")
 STOCHASTIC = ("greedy", "ga-plain", "ga")
+TABLE1_SCENARIOS = ("paper_11x11_fig13d", "tiling_11x11")
+"""Table 1's maps: the paper's 11 × 11 tileset and our tiling of its map (tiled first, by backtracking)."""
+TABLE2_SCENARIOS = ("paper_10x10_fig13c",)
+"""Table 2's map: the paper's 10 × 10 tileset."""
 METHOD_NAMES = {
     "zigzag": "Zigzag 1 row", "zigzag2": "Zigzag 2 rows", "spiral": "Spiral 1 row", "spiral2": "Spiral 2 rows",
     "greedy": "Greedy search", "ga-plain": "GA (paper's, DEAP)", "ga": "GA + 2-opt/Or-opt (memetic)",
@@ -259,26 +285,28 @@ def markdown_report(records: Iterable[dict]) -> str:
     for name in dict.fromkeys(r["tileset"] for r in records if r["table"] == 1):
         rows = [r for r in records if r["table"] == 1 and r["tileset"] == name]
         optimum = rows[0]["optimum"]
+        best = "no optimum" if optimum is None else f"optimum {optimum:.3f}{'' if rows[0]['proven'] else ' (not proven)'}"
         out += [f"### Table 1 on {name} ({len(rows[0]['order'])} waypoints, start tile {rows[0]['order'][0]}; "
-                f"optimum {optimum:.3f}{'' if rows[0]['proven'] else ' (not proven)'})", "",
+                f"{best})", "",
                 "| method | cost (ours) | gap to optimum | time s (ours) | cost (paper) | time s (paper) |",
                 "|---|---|---|---|---|---|"]
         for method in dict.fromkeys(r["method"] for r in rows):
             mine = [r for r in rows if r["method"] == method]
-            cost, gap, runtime = (mean_std([r[k] for r in mine]) for k in ("cost", "gap_pct", "runtime_s"))
+            cost, gap, runtime = (mean_std([r[k] for r in mine if r[k] is not None])
+                                  for k in ("cost", "gap_pct", "runtime_s"))
             paper = PAPER_TABLE1.get(method, (None, None))
             runs = f" ({len(mine)} seeds)" if len(mine) > 1 else ""
             out.append(f"| {METHOD_NAMES.get(method, method)}{runs} | {format_mean_std(*cost, digits=3)} | "
                        f"{format_mean_std(*gap, digits=2)} % | {format_mean_std(*runtime, digits=3)} | "
                        f"{_fmt(paper[0])} | {_fmt(paper[1])} |")
         out.append("")
-    rows = [r for r in records if r["table"] == 2]
-    if rows:
-        out += [f"### Table 2 on {rows[0]['tileset']}: optimal order under each weight setting", "",
+    for name in dict.fromkeys(r["tileset"] for r in records if r["table"] == 2):
+        rows = [r for r in records if r["table"] == 2 and r["tileset"] == name]
+        out += [f"### Table 2 on {name}: optimal order under each weight setting", "",
                 "| weights α,β,λ,γ | meaning | cost, own weights (ours) | cost, 4 blocks (ours) | own (paper) | 4 blocks (paper) |",
                 "|---|---|---|---|---|---|"]
         out += [f"| {r['weights']} | {r['meaning']} | {r['cost_own']:.3f} | {r['cost_four']:.3f} | "
-                f"{r['paper_own']:.3f} | {r['paper_four']:.3f} |" for r in rows]
+                f"{_fmt(r['paper_own'])} | {_fmt(r['paper_four'])} |" for r in rows]
         out.append("")
     rows = [r for r in records if r["table"] == 3]
     if rows:
@@ -314,3 +342,189 @@ def write_csv(records: Iterable[dict], path) -> Path:
     with atomic_path(path) as tmp:
         tmp.write_text(buffer.getvalue(), encoding="utf-8")
     return Path(path)
+
+
+# --- on the study runner ---------------------------------------------------------------------------
+def _weights_label(weights: Sequence[float]) -> str:
+    return ",".join(f"{float(w):g}" for w in weights)
+
+
+def seed003_study(seeds: int | Sequence[int] = 5, *, methods: Sequence[str] = TABLE1_METHODS,
+                  weights: bool = True, scenarios: Sequence[str] = TABLE1_SCENARIOS + TABLE2_SCENARIOS,
+                  time_limit: float | None = None) -> Study:
+    """Tables 1 and 2 as a study of the runner (task ``sequence``, metric ``"gap"``); with the
+    defaults the bundled study ``seed003`` (``load_study("seed003")``).
+
+    Parameters
+    ----------
+    seeds : int or sequence of int
+        N for seeds 0 … N−1, or the seeds (the stochastic methods, :data:`STOCHASTIC`, run once per seed).
+    methods : sequence of str, keyword-only
+        Table 1's methods, one entry each, labelled by the method's name.
+    weights : bool, keyword-only
+        Add Table 2's entries: the exact method under each weight setting of :data:`PAPER_TABLE2`,
+        labelled ``"exact, weights a,b,c,d"``.
+    scenarios : sequence of str, keyword-only
+        Labelled tilesets, or maps tiled first (every entry runs on every scenario).
+    time_limit : float, optional, keyword-only
+        A cap in seconds on each method but the exact one (whose results are the optimum).
+
+    Returns
+    -------
+    Study
+
+    Raises
+    ------
+    StudyError
+        If a method or scenario is unknown, or a value out of range.
+
+    Examples
+    --------
+    >>> study = seed003_study(2, methods=("zigzag", "greedy"), weights=False, scenarios=["paper_6x6_fig13a"])
+    >>> [(t.label, t.seed) for t in study.trials()]
+    [('zigzag', None), ('greedy', 0), ('greedy', 1)]
+    """
+    if isinstance(methods, str) or not isinstance(methods, Sequence):
+        raise ParameterError(f"methods must be a list of sequencing methods, got {methods!r}")
+    time_limit = check_time_limit(time_limit)
+    cap = {} if time_limit is None else {"time_limit": time_limit}
+    entries: list[dict[str, Any]] = [{"method": m, **({} if m == "exact" else cap)} for m in methods]
+    if weights:
+        entries += [{"label": f"exact, weights {_weights_label(w)}", "method": "exact", "weights": list(w)}
+                    for w, *_ in PAPER_TABLE2]
+    if not isinstance(seeds, numbers.Integral) and isinstance(seeds, Iterable):
+        seeds = list(seeds)
+    return Study(name="seed003", task="sequence", scenarios=tuple(scenarios) if isinstance(scenarios, Sequence)
+                 and not isinstance(scenarios, str) else scenarios, methods=entries, seeds=seeds, metrics=("gap",),
+                 description="Le et al. 2018, Tables 1, 2, 4 and 5: waypoint sequencing on the paper's tilesets, "
+                             "with the gap to the optimum")
+
+
+def run_seed003(seeds: int | Sequence[int] = 5, *, methods: Sequence[str] = TABLE1_METHODS, weights: bool = True,
+                scenarios: Sequence[str] = TABLE1_SCENARIOS + TABLE2_SCENARIOS, time_limit: float | None = None,
+                executor: str = "processes", workers: int | None = None, out: str | os.PathLike | None = None,
+                resume: bool = False, progress=None) -> StudyRun:
+    """Run :func:`seed003_study` on the study runner (its own ``sequence`` trial); ``report(run)``
+    lays the result out as the paper's tables.
+
+    ``executor``, ``workers``, ``out``, ``resume`` and ``progress`` are
+    :func:`~htetro_opt.studies.runner.run_study`'s (``progress(done, total, note)``), the other
+    arguments :func:`seed003_study`'s.
+    """
+    study = seed003_study(seeds, methods=methods, weights=weights, scenarios=scenarios, time_limit=time_limit)
+    return run_runner_study(study, out=out, executor=executor, workers=workers, resume=resume, progress=progress)
+
+
+def _is_tileset(scenario: str) -> bool:
+    """The runner's rule for ``sequence``: a bundled tileset or a non-``.toml`` file is a labelled
+    tileset, a bundled map or a ``.toml`` file a map tiled first."""
+    if scenario.endswith(".toml"):
+        return False
+    return scenario in list_tilesets() or scenario not in list_scenarios()
+
+
+def _tileset(scenario: str, shapes: str | None) -> Tileset:
+    """The tileset a ``sequence`` trial on ``scenario`` ordered, named as the report names it (the
+    tiling without shuffle is deterministic, so this is the trial's)."""
+    if scenario in PAPER_TILESETS:
+        return paper_tileset(scenario)
+    if _is_tileset(scenario):
+        return load_tileset(tileset_path(scenario))
+    workspace = load_scenario(scenario).workspace
+    ts = tile_workspace(workspace, shapes=list(shapes) if shapes else None)
+    name = f"ours {Path(scenario).stem if scenario.endswith('.toml') else scenario} "
+    name += f"({shapes}, backtracking)" if shapes else "(backtracking)"
+    return Tileset(ts.occupancy, ts.blocks, ts.ids, workspace.cell_size, name)
+
+
+def _order(record: Mapping[str, Any], tileset: Tileset) -> list[int]:
+    order = [int(t) for t in str(record["order"]).split(",")]
+    if sorted(order) != sorted(tileset.ids):
+        raise ParameterError(f"the order of {record['scenario']} {record['label']} does not visit the tiles of "
+                             f"{tileset.name} (was the scenario changed since the run?)")
+    return order
+
+
+def _reference(record: Mapping[str, Any], references: Sequence[Mapping[str, Any]]) -> Mapping[str, Any] | None:
+    for ref in references:
+        if ref.get("scenario") == record["scenario"] and all(
+                ref.get(k) == record.get(k) for k in ("start", "weights", "shapes")):
+            return ref
+    return None
+
+
+def _legacy_records(run: StudyRun) -> list[dict]:
+    """The runner's records as :func:`run_study`'s (Tables 1, 2 and 4), for :func:`markdown_report`."""
+    records: list[dict] = []
+    table1: dict[str, list[dict]] = {}
+    table2: list[dict] = []
+    tilesets: dict[tuple, Tileset] = {}
+    for r in run.records:
+        if r.get("error") is not None:
+            continue
+        where = (r["scenario"], r.get("shapes"))
+        if where not in tilesets:
+            tilesets[where] = _tileset(*where)
+        ts = tilesets[where]
+        order = _order(r, ts)
+        ref = _reference(r, run.references)
+        optimum = None if ref is None else ref.get("cost")
+        if r.get("weights") is None:
+            gap = None if optimum is None else 100.0 * (r["cost"] - optimum) / optimum
+            table1.setdefault(ts.name, []).append({
+                "table": 1, "tileset": ts.name, "method": r["label"], "seed": r["seed"], "cost": r["cost"],
+                "runtime_s": r["runtime_s"], "optimum": optimum, "proven": bool(ref and ref.get("optimal")),
+                "gap_pct": gap, "order": order})
+        else:
+            weights = tuple(float(w) for w in r["weights"])
+            paper = {tuple(w): (meaning, own, four) for w, meaning, own, four in PAPER_TABLE2}.get(weights)
+            equal = SequencingInstance.from_tileset(ts, start=order[0])
+            table2.append({
+                "table": 2, "tileset": ts.name, "weights": _weights_label(weights),
+                "meaning": paper[0] if paper else "", "cost_own": r["cost"],
+                "cost_four": path_cost(equal.cost, [ts.index(t) for t in order]),
+                "paper_own": paper[1] if paper else None, "paper_four": paper[2] if paper else None,
+                "proven": r["method"] == "exact" and bool(ref and ref.get("optimal"))})
+    for rows in table1.values():
+        records += rows
+    records += table2
+    for name, rows in table1.items():
+        ts = next(t for t in tilesets.values() if t.name == name)
+        records += run_table45(ts, rows)
+    return records
+
+
+def report(run: StudyRun, *, table3: Iterable[dict] | None = None) -> str:
+    """The Markdown tables of a run of the ``seed003`` study, the paper's numbers beside ours: the
+    same layout as :func:`markdown_report`'s.
+
+    Table 1 on each scenario from the records without ``weights`` (each method's gap to the proven
+    optimum, the study's reference), Table 2 from those with ``weights`` (each order priced also at
+    equal weights), Tables 4–5 from the coverage simulation of each Table-1 method's first recorded
+    order. Table 3 is not a runner task: pass :func:`run_table3`'s records as ``table3``. Failed
+    trials are listed at the end.
+
+    Raises
+    ------
+    ParameterError
+        If ``run`` is not a :class:`~htetro_opt.studies.runner.StudyRun` of the ``sequence`` task,
+        or a recorded order does not fit its scenario's tileset.
+    """
+    if not isinstance(run, StudyRun):
+        raise ParameterError(f"run must be the StudyRun of run_study, got {run!r}")
+    if run.study.task != "sequence":
+        raise ParameterError(f"the seed003 report lays out sequencing studies, not task {run.study.task!r}")
+    records = _legacy_records(run)
+    if table3 is not None:
+        rows = list(table3)
+        if any(not isinstance(r, Mapping) or r.get("table") != 3 for r in rows):
+            raise ParameterError("table3 must be run_table3's records")
+        first4 = next((i for i, r in enumerate(records) if r["table"] == 4), len(records))
+        records[first4:first4] = rows
+    text = markdown_report(records)
+    failed = [r for r in run.records if r.get("error") is not None]
+    if failed:
+        text += "\n".join(["### Failed trials", ""] + [
+            f"- {r['scenario']} {r['label']}" + ("" if r["seed"] is None else f" seed {r['seed']}") + f": {r['error']}"
+            for r in failed]) + "\n"
+    return text

@@ -11,6 +11,7 @@ from htetro_opt.errors import ParameterError
 from htetro_opt.problems import SequencingInstance
 from htetro_opt.solvers.sequencing import held_karp
 from htetro_opt.studies import seed003
+from htetro_opt.studies.runner import StudyRun, load_study, run_study
 
 
 def eq2_cost(tileset, tiles, weights=(0.25,) * 4):
@@ -97,4 +98,75 @@ def test_bad_seeds_and_command_line_errors(capsys):
 @pytest.mark.slow
 def test_the_whole_study_runs_and_writes_its_files(tmp_path):
     assert cli_main(["study", "seed003", "--seeds", "1", "--out", str(tmp_path)]) == 0
-    assert (tmp_path / "seed003.md").read_text().count("### Table") >= 4
+    assert (tmp_path / "seed003_paper.md").read_text().count("### Table") >= 4
+
+
+# --- on the study runner ---------------------------------------------------------------------------
+RUNNER_METHODS = ("zigzag", "spiral2", "greedy", "ga-plain", "ga", "local", "exact")
+
+
+@pytest.fixture(scope="module")
+def runner_run():
+    study = seed003.seed003_study([0, 1], methods=RUNNER_METHODS, scenarios=["paper_8x7_fig13b"])
+    return run_study(study, executor="serial")
+
+
+def _without_runtimes(text):
+    """The report's lines, Table 1's runtime column blanked (the only wall-clock numbers)."""
+    out = []
+    for line in text.splitlines():
+        cells = line.split(" | ")
+        if len(cells) == 6 and cells[2].endswith("%"):
+            cells[3] = "T"
+        out.append(" | ".join(cells))
+    return out
+
+
+def test_the_bundled_study_is_the_builders():
+    study = load_study("seed003")
+    assert study == seed003.seed003_study()
+    assert study.task == "sequence" and study.metrics == ("gap",)
+    assert study.scenarios == seed003.TABLE1_SCENARIOS + seed003.TABLE2_SCENARIOS
+    labels = [m.label for m in study.methods]
+    assert labels[:len(seed003.TABLE1_METHODS)] == list(seed003.TABLE1_METHODS)
+    assert [m.options["weights"] for m in study.methods[len(seed003.TABLE1_METHODS):]] == \
+        [list(w) for w, *_ in seed003.PAPER_TABLE2]
+
+
+def test_the_runner_path_gives_the_old_paths_numbers(fig13b, runner_run):
+    old1 = seed003.run_table1(fig13b, seeds=[0, 1], methods=RUNNER_METHODS)
+    old = {(r["method"], r["seed"] if r["method"] in seed003.STOCHASTIC else None): r for r in old1}
+    table1 = [r for r in runner_run.records if r.get("weights") is None]
+    assert all(r["error"] is None for r in runner_run.records)
+    assert {(r["label"], r["seed"]) for r in table1} == set(old)
+    for r in table1:
+        mine = old[r["label"], r["seed"]]
+        assert r["cost"] == pytest.approx(mine["cost"], rel=1e-12)
+        assert r["order"] == ",".join(map(str, mine["order"]))
+        assert 100 * r["gap"] == pytest.approx(mine["gap_pct"], abs=1e-9)
+    weighted = [r for r in runner_run.records if r.get("weights") is not None]
+    old2 = seed003.run_table2(fig13b)
+    assert [r["cost"] for r in weighted] == pytest.approx([r["cost_own"] for r in old2], rel=1e-9)
+
+    # the report is today's, Tables 2 and 4–5 to the digit, Table 1 but for its runtimes
+    text = seed003.report(runner_run)
+    expected = seed003.markdown_report(old1 + old2 + seed003.run_table45(fig13b, old1))
+    assert _without_runtimes(text) == _without_runtimes(expected)
+    assert "### Table 1 on paper_8x7_fig13b" in text and "62.368" in text and "1890" in text
+
+
+def test_the_report_takes_table3_and_lists_failed_trials(runner_run):
+    table3 = [{"table": 3, "workspace": "tiling_8x7", "tileset": "x", "shapes": "IJ", "tiles": 14,
+               "cost": 17.0, "paper": 30.761, "proven": True}]
+    failed = dict(runner_run.records[0], error="TimeoutError: over")
+    run = StudyRun(runner_run.study, [failed] + runner_run.records[1:], runner_run.references,
+                   runner_run.summary, None)
+    text = seed003.report(run, table3=table3)
+    assert text.index("### Table 2") < text.index("### Table 3") < text.index("### Tables 4–5")
+    assert "| tiling_8x7 | x | IJ | 14 | 17.000 | 30.761 |" in text
+    assert text.rstrip().endswith("- paper_8x7_fig13b zigzag: TimeoutError: over")
+    assert "Zigzag 1 row" not in text.split("### Table 2")[0]
+    with pytest.raises(ParameterError, match="StudyRun"):
+        seed003.report(runner_run.records)
+    with pytest.raises(ParameterError, match="run_table3"):
+        seed003.report(runner_run, table3=[{"table": 1}])
