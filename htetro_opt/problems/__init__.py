@@ -2,6 +2,9 @@
 
 - :mod:`~htetro_opt.problems.command_path` (Cheng et al. 2020): variable-length motion-command
   chromosomes with the four fitnesses of eqs. 3–6, as a pymoo problem;
+- :mod:`~htetro_opt.problems.heat_costs` (Do et al. 2021): the paper's weighted costs (eqs. 9–12, the
+  safety of its Fig. 5) of any path, for its heat-conduction planner (in progress) and for comparing
+  every planner on them;
 - :mod:`~htetro_opt.problems.waypoint_sequencing` (Le et al. 2018): tile waypoints (Algorithm 1), the
   eq.-2 block-displacement cost and the open-path TSP over them, for every sequencing method, plus
   :class:`SequencingProblem`, the same as a pymoo permutation problem.
@@ -18,4 +21,6 @@ __getattr__, __dir__, __all__ = attach(__name__, {
        ("DEFAULT_BLOCK_WEIGHTS", "SequencingInstance", "block_locations", "check_weights", "cost_matrix",
         "path_cost", "check_instance")},
     "SequencingProblem": "._sequencing_problem",
+    **{name: ".heat_costs" for name in
+       ("HEAT_COST_NAMES", "SAFETY_RADIUS", "default_t_max", "safety_pattern", "heat_fitness")},
 })
