@@ -70,7 +70,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="dijkstra (default), astar: the minimum-time plan (the same optimum); htetro-ga: the "
                         "multi-objective GA over command chromosomes of Cheng et al. 2020 with our additions "
                         "(htetro-ga-paper: as published); nsga2, nsga3, smsemoa, agemoea: pymoo's algorithms "
-                        "on the same problem")
+                        "on the same problem; heat: Do et al. 2021's search up a heat-conduction field "
+                        "(diagonals included, static maps)")
     p.add_argument("--pop-size", type=int, help=f"GA methods: population size n_pop (default {GA_DEFAULTS['pop_size']})")
     p.add_argument("--max-gen", type=int,
                    help=f"GA methods: generations per roadmap leg at most (default {GA_DEFAULTS['max_gen']})")
@@ -83,6 +84,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int,
                    help=f"GA methods: random seed, the same seed giving the same plan (default {GA_DEFAULTS['seed']})")
     p.add_argument("--diagonals", action="store_true", help="dijkstra, astar: allow diagonal translations")
+    p.add_argument("--weights", metavar="WT,WSM,WSF",
+                   help="heat: weights of time, smoothness and safety (default 1,0,0; smoothness not yet available)")
+    p.add_argument("--t-max", type=float, metavar="S",
+                   help="heat: t_max of f_t in seconds (default: half an O-shape boustrophedon of the empty map)")
+    p.add_argument("--element", choices=("q1", "p0"),
+                   help="heat: the field's element, bilinear q1 (default, the paper's) or cell-centred p0")
+    p.add_argument("--no-monotone", action="store_true",
+                   help="heat: drop the rule that translations never go down the temperature field")
     p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
@@ -295,9 +304,25 @@ def _cmd_plan(args) -> dict:
     _outputs(args, ("plot", "plot"), ("gif", "animation"))
     if scenario.goal is None:
         raise PlanningError(f"scenario {scenario.name!r} has no roadmap with a start and a goal to plan for")
-    genetic = args.method not in EXACT_METHODS
+    heat = args.method == "heat"
+    genetic = args.method not in EXACT_METHODS and not heat
     given = {name: getattr(args, name) for name in GA_DEFAULTS if getattr(args, name) is not None}
-    if genetic:
+    heat_given = [flag for flag, value in (("--weights", args.weights), ("--t-max", args.t_max),
+                                           ("--element", args.element), ("--no-monotone", args.no_monotone))
+                  if value]
+    if heat_given and not heat:
+        raise ParameterError(f"{', '.join(heat_given)} applies to --method heat only")
+    if heat:
+        if given or args.diagonals:
+            flags = [("--" + name.replace("_", "-")) for name in given] + (["--diagonals"] if args.diagonals else [])
+            raise ParameterError(f"{', '.join(flags)} does not apply to --method heat (its commands include the "
+                                 "diagonals; it has no population or randomness)")
+        options = dict(weights=_heat_weights(args.weights), monotone=not args.no_monotone)
+        if args.t_max is not None:
+            options["t_max"] = check_real(args.t_max, "--t-max (seconds)", minimum=0.0, include_minimum=False)
+        if args.element:
+            options["element"] = args.element
+    elif genetic:
         if args.diagonals:
             raise ParameterError(f"--diagonals is not available with --method {args.method} "
                                  "(the command chromosomes of Cheng et al. 2020 have no diagonal commands)")
@@ -330,6 +355,9 @@ def _cmd_plan(args) -> dict:
     }
     if genetic:
         out.update(_ga_fields(plan, args))
+    if heat:
+        out.update({key: plan.info[key] for key in ("fitness", "weights", "t_max", "relaxed", "field")
+                    if key in plan.info})
     if args.plot:
         from htetro_opt.viz import plot_ga_plan, plot_path
 
@@ -479,6 +507,19 @@ def _cmd_tile(args) -> dict:
     else:
         print(format_tileset(tileset))
     return out
+
+
+def _heat_weights(text: str | None) -> tuple[float, float, float]:
+    """``--weights WT,WSM,WSF`` of the heat planner (Do et al. 2021's eq. 12)."""
+    if text is None:
+        return (1.0, 0.0, 0.0)
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(np.isfinite(values)) or min(values) < 0 or sum(values) <= 0:
+        raise ParameterError(f"--weights must be three numbers WT,WSM,WSF >= 0 with a positive sum, got {text!r}")
+    return values
 
 
 def _weights(text: str) -> np.ndarray:

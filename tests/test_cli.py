@@ -975,3 +975,33 @@ def test_study_seed003_runs_on_the_runner_and_resumes(capsys, tmp_path):
     lines = (out_dir / "seed003.jsonl").read_text().splitlines()
     again = run_json(capsys, [*argv, "--resume", "--json"])  # nothing left to run: the same records
     assert again["trials"] == len(again["records"]) and (out_dir / "seed003.jsonl").read_text().splitlines() == lines
+
+
+# --------------------------------------------------------------------------------------------------
+# plan --method heat (Do et al. 2021)
+
+
+def test_plan_heat_json_and_replay(capsys):
+    out = run_json(capsys, ["plan", "h_shape", "--method", "heat", "--weights", "1,0,1", "--json"])
+    assert out["method"] == "heat" and out["reached"] is True
+    assert set(out["fitness"]) == {"f_t", "f_sm", "f_sf", "f"} and out["weights"] == [1.0, 0.0, 1.0]
+    exact = run_json(capsys, ["plan", "h_shape", "--diagonals", "--json"])
+    assert out["time"] >= exact["time"] - 1e-9  # no method beats the proven optimum
+    replay = run_json(capsys, ["simulate", "h_shape", "--commands", ",".join(out["commands"]), "--json"])
+    assert replay["reached"] is True and replay["time"] == pytest.approx(out["time"])
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["--method", "heat", "--weights", "0,0,0"], ["--weights"]),
+    (["--method", "heat", "--weights", "1,2"], ["--weights"]),
+    (["--method", "heat", "--pop-size", "5"], ["--pop-size", "heat"]),
+    (["--method", "heat", "--t-max", "-1"], ["--t-max"]),
+    (["--t-max", "5"], ["--t-max", "heat"]),
+    (["--method", "htetro-ga", "--element", "p0"], ["--element", "heat"]),
+])
+def test_plan_heat_bad_options(capsys, argv, words):
+    assert_one_error_line(*run(capsys, ["plan", "h_shape", *argv]), *words)
+
+
+def test_plan_heat_refuses_moving_obstacles(capsys):
+    assert_one_error_line(*run(capsys, ["plan", "parallel_dynamic", "--method", "heat"]), "static")

@@ -6,9 +6,11 @@
   (:func:`plan_ga`): Cheng et al. 2020's multi-objective GA over motion-command chromosomes, or one
   of pymoo's algorithms over the same problem, leg by leg.
 
-Every method returns a :class:`Plan`, re-validated in the simulator. :func:`solve_heat_field` is the
-steady heat-conduction field of Do et al. 2021 (scikit-fem's bilinear element, or cell-centred), the
-first part of that paper's planner, which is still to come.
+- ``"heat"`` (:func:`plan_heat`): Do et al. 2021's heat-conduction planner, a search that climbs
+  each leg's temperature field (:func:`solve_heat_field`, scikit-fem's bilinear element or
+  cell-centred), static maps only.
+
+Every method returns a :class:`Plan`, re-validated in the simulator.
 """
 
 from htetro_opt._lazy import attach
@@ -18,5 +20,6 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "Plan": "._result", "FrontMember": "._result", "LegResult": "._result",
     "plan_exact": "._exact", "EXACT_METHODS": "._exact",
     "plan_ga": "._ga",
+    "plan_heat": "._heat",
     "solve_heat_field": "._heat_field", "HeatField": "._heat_field",
 })

@@ -18,9 +18,11 @@ from htetro_opt.solvers.grid_paths._result import Plan, finish_plan, prepare
 
 __all__ = ["PLAN_METHODS", "plan_path"]
 
-PLAN_METHODS = ("dijkstra", "astar", "htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea")
+PLAN_METHODS = ("dijkstra", "astar", "htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea",
+                "heat")
 """Method names :func:`plan_path` knows: the two exact graph searches (the same optimum), the
-hTetro-GA of Cheng et al. 2020 (with our additions, or as published) and four of pymoo's algorithms
+hTetro-GA of Cheng et al. 2020 (with our additions, or as published), four of pymoo's algorithms and
+Do et al. 2021's heat-conduction planner (last); for the GAs, pymoo's algorithms
 over the same command chromosomes."""
 
 _COMPILE = ("commands", "diagonals", "timing", "clearance")
@@ -44,7 +46,9 @@ def plan_path(workspace: Workspace | Simulator, roadmap: Sequence[Pose], *,
           (:func:`~htetro_opt.solvers.grid_paths.plan_exact`);
         - ``"htetro-ga"``, ``"htetro-ga-paper"``, ``"nsga2"``, ``"nsga3"``, ``"smsemoa"``,
           ``"agemoea"``: a multi-objective GA over command chromosomes, leg by leg
-          (:func:`~htetro_opt.solvers.grid_paths.plan_ga`).
+          (:func:`~htetro_opt.solvers.grid_paths.plan_ga`);
+        - ``"heat"``: Do et al. 2021's heat-conduction planner, static maps only
+          (:func:`~htetro_opt.solvers.grid_paths.plan_heat`).
 
         Or a callable ``method(simulator, roadmap, **options)`` returning the plan's commands (tokens
         or global ids) from the roadmap's start; it gets a compiled
@@ -90,13 +94,18 @@ def plan_path(workspace: Workspace | Simulator, roadmap: Sequence[Pose], *,
     if method in EXACT_METHODS:
         _check_options(plan_exact, options, method)
         return plan_exact(workspace, roadmap, method=method, **options)
+    if method == "heat":
+        from htetro_opt.solvers.grid_paths._heat import plan_heat
+
+        _check_options(plan_heat, options, method)
+        return plan_heat(workspace, roadmap, **options)
     if method in PLAN_METHODS:
         from htetro_opt.solvers.grid_paths._ga import plan_ga  # pymoo's algorithms load only when used
 
         _check_options(plan_ga, options, method)
         return plan_ga(workspace, roadmap, algorithm=method, **options)
-    raise ParameterError(f"unknown planning method {method!r}: expected one of {', '.join(PLAN_METHODS)} "
-                         "or a callable")
+    raise ParameterError(f"unknown planning method {method!r}: expected one of {', '.join(PLAN_METHODS)}, "
+                         "heat or a callable")
 
 
 def _check_options(function: Callable, options: dict, method: str) -> None:

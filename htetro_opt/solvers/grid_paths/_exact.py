@@ -121,22 +121,38 @@ def _check_memory(workspace: Workspace | Simulator, method: str, commands, diago
 class _Graph:
     """The simulator's transition table as a (time-expanded) CSR graph, cheapest command per edge.
 
-    With ``static``, moving obstacles are ignored (the table itself only knows the static map).
+    With ``static``, moving obstacles are ignored (the table itself only knows the static map). A
+    ``mask`` (n_poses, n_commands) of allowed edges narrows the graph, and ``weights`` of the same
+    shape (positive where usable) replace the commands' durations as edge costs (static maps only);
+    the cheapest command per edge is then the one of least weight.
     """
 
-    def __init__(self, sim: Simulator, *, static: bool = False) -> None:
+    def __init__(self, sim: Simulator, *, static: bool = False, mask: np.ndarray | None = None,
+                 weights: np.ndarray | None = None) -> None:
         self.sim = sim
         self.moving = bool(sim.workspace.moving) and not static
         self.period = sim.workspace.period if self.moving else 1
         n, c = sim.n_poses, sim.n_commands
+        if weights is not None and self.moving:
+            raise PlanningError("per-edge weights need a static map")
         self.target = sim.next[:n, :c]
+        self.weights = weights
         usable = self.target != sim.dead
+        if mask is not None:  # before the colliding columns: a masked cheap edge must not hide a costly one
+            usable &= mask
         if not self.moving:
             # A command that leaves the pose unchanged is useless on a static map; with moving
             # obstacles it is a wait, which advances their clock.
             usable &= self.target != np.arange(n, dtype=self.target.dtype)[:, None]
+        # One edge per (pose, next pose): the CSR graph would otherwise sum the duplicates' costs.
         for cheap, costly in self._colliding_columns():
-            usable[:, costly] &= ~(usable[:, cheap] & (self.target[:, cheap] == self.target[:, costly]))
+            same = usable[:, cheap] & usable[:, costly] & (self.target[:, cheap] == self.target[:, costly])
+            if weights is None:
+                usable[:, costly] &= ~same
+            else:
+                lighter = weights[:, cheap] <= weights[:, costly]
+                usable[:, costly] &= ~(same & lighter)
+                usable[:, cheap] &= ~(same & ~lighter)
         self.usable = usable
         if (sim.durations[:c] <= 0).any() and usable[:, sim.durations[:c] <= 0].any():
             raise PlanningError("exact planning needs every command that moves the robot to take a positive time")
@@ -172,7 +188,8 @@ class _Graph:
         if self._matrix is None:
             sim = self.sim
             period, n = self.period, sim.n_poses
-            weights = np.broadcast_to(sim.durations[: sim.n_commands], self.target.shape)
+            weights = (np.broadcast_to(sim.durations[: sim.n_commands], self.target.shape) if self.weights is None
+                       else self.weights)
             indptr, indices, data = [np.zeros(1, dtype=np.int64)], [], []
             for phase in range(period):
                 usable = self._usable_at(phase)
@@ -188,7 +205,8 @@ class _Graph:
     def step_command(self, u: int, v: int, phase: int) -> int:
         """Local command of the cheapest usable edge u → v at time ``phase``."""
         candidates = np.flatnonzero((self.target[u] == v) & self.usable_row(u, phase))
-        return int(candidates[np.argmin(self.sim.durations[candidates])])
+        costs = self.sim.durations[candidates] if self.weights is None else self.weights[u, candidates]
+        return int(candidates[np.argmin(costs)])
 
     def usable_row(self, u: int, phase: int) -> np.ndarray:
         """Which commands can be executed from pose u at time ``phase``."""

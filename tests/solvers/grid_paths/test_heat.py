@@ -1,0 +1,153 @@
+"""plan_heat: Do et al. 2021's search up the temperature field, checked against the simulator, an
+independently solved field, the exact planner and the paper's cost measure."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from htetro_opt.errors import ParameterError, PlanningError
+from htetro_opt.model import Pose, Simulator, Workspace
+from htetro_opt.model.commands import COMMANDS, command_set
+from htetro_opt.problems.heat_costs import heat_fitness
+from htetro_opt.scenarios import load_scenario
+from htetro_opt.solvers.grid_paths import plan_exact, plan_heat, plan_path, solve_heat_field
+
+MAPS = ("random", "h_shape", "three_slit", "maze")
+
+
+def _replay(workspace, plan, start):
+    sim = Simulator(workspace, diagonals=True)
+    result = sim.run([plan.commands], start)
+    assert result.valid[0] and int(result.executed[0]) == len(plan.commands)
+    return result.final_pose(0)
+
+
+@pytest.mark.parametrize("name", MAPS)
+@pytest.mark.parametrize("weights", [(1.0, 0.0, 0.0), (0.0, 0.0, 1.0), (1.0, 0.0, 1.0)])
+def test_plans_revalidate_reach_the_goal_and_climb_the_field(name, weights):
+    scenario = load_scenario(name)
+    plan = plan_heat(scenario.workspace, scenario.roadmap, weights=weights)
+    assert plan.method == "heat" and plan.reached and plan.failed_leg == -1
+    assert _replay(scenario.workspace, plan, scenario.start) == scenario.goal
+    assert plan.info["relaxed"] == [False]
+    # the temperature of B2's cell, from a field solved here, never drops on a translation
+    start, goal = scenario.start, scenario.goal
+    field = solve_heat_field(scenario.workspace, (goal.x, goal.y), (start.x, start.y), element="q1")
+    temperature = field.cells[plan.poses[:, 1], plan.poses[:, 0]]
+    assert temperature[0] == 0.0 and temperature[-1] == 1.0
+    moves = np.array([COMMANDS[int(c)].kind in ("translation", "diagonal") for c in plan.commands])
+    drops = temperature[:-1] - temperature[1:]
+    assert moves.any() and (drops[moves] <= field.epsilon).all()
+    fitness = heat_fitness(scenario.workspace, plan.poses, plan.commands, weights=weights)
+    assert plan.info["fitness"] == pytest.approx(fitness)
+    assert plan.info["weights"] == list(weights) and plan.info["t_max"] > 0
+    assert plan.info["field"][0]["element"] == "q1" and plan.info["field"][0]["dofs"] > 0
+
+
+@pytest.mark.parametrize("name", MAPS)
+def test_unconstrained_time_plan_is_the_exact_optimum_and_the_monotone_one_no_faster(name):
+    scenario = load_scenario(name)
+    exact = plan_exact(scenario.workspace, scenario.roadmap, diagonals=True)
+    free = plan_heat(scenario.workspace, scenario.roadmap, monotone=False)
+    monotone = plan_heat(scenario.workspace, scenario.roadmap)
+    assert free.time == pytest.approx(exact.time, abs=1e-9)
+    assert monotone.time >= exact.time - 1e-9
+    assert free.info["relaxed"] == [False]
+
+
+@pytest.mark.parametrize("name", MAPS)
+@pytest.mark.parametrize("monotone", [True, False])
+def test_safety_weight_buys_safety_and_time_weight_buys_time(name, monotone):
+    scenario = load_scenario(name)
+    fast = plan_heat(scenario.workspace, scenario.roadmap, weights=(1, 0, 0), monotone=monotone)
+    safe = plan_heat(scenario.workspace, scenario.roadmap, weights=(0, 0, 1), monotone=monotone)
+    assert safe.info["fitness"]["f_sf"] >= fast.info["fitness"]["f_sf"] - 1e-12
+    assert fast.time <= safe.time + 1e-9
+
+
+def test_a_safety_plan_differs_from_the_time_plan_somewhere():
+    scenario = load_scenario("h_shape")  # a case where the weights matter: else the test above is vacuous
+    fast = plan_heat(scenario.workspace, scenario.roadmap, weights=(1, 0, 0))
+    safe = plan_heat(scenario.workspace, scenario.roadmap, weights=(0, 0, 1))
+    assert safe.info["fitness"]["f_sf"] > fast.info["fitness"]["f_sf"] + 0.1
+    assert safe.time > fast.time
+
+
+def test_no_monotone_path_relaxes_the_leg_to_the_unconstrained_optimum():
+    # a 10 x 10 map found by a random search: the O-shape must cool down to reach the goal
+    occ = np.zeros(100, dtype=bool)
+    occ[[12, 16, 18, 21, 26, 36, 38, 46, 47, 51, 60, 64, 72, 78, 80, 82, 88, 89, 91, 92]] = True
+    ws = Workspace(occ.reshape(10, 10))
+    roadmap = [Pose(4, 5, "O", 0), Pose(6, 7, "O", 0)]
+    plan = plan_heat(ws, roadmap)
+    assert plan.reached and plan.info["relaxed"] == [True]
+    assert _replay(ws, plan, roadmap[0]) == roadmap[-1]
+    free = plan_heat(ws, roadmap, monotone=False)
+    assert plan.time == pytest.approx(free.time) and free.info["relaxed"] == [False]
+    field = solve_heat_field(ws, (6, 7), (4, 5))
+    temperature = field.cells[plan.poses[:, 1], plan.poses[:, 0]]
+    moves = np.array([COMMANDS[int(c)].kind in ("translation", "diagonal") for c in plan.commands])
+    assert ((temperature[:-1] - temperature[1:])[moves] > field.epsilon).any()  # it really had to cool down
+
+
+def test_multi_leg_roadmaps_plan_leg_by_leg():
+    ws = Workspace(np.zeros((10, 10), dtype=bool))
+    roadmap = [Pose(1, 1, "O", 0), Pose(7, 2, "O", 0), Pose(2, 7, "I", 1)]
+    plan = plan_heat(ws, roadmap, weights=(1, 0, 1))
+    assert plan.reached and len(plan.leg_ends) == 2 and len(plan.info["field"]) == 2
+    assert _replay(ws, plan, roadmap[0]) == roadmap[-1]
+    assert tuple(plan.poses[plan.leg_ends[0], :2]) == (7, 2)
+
+
+def test_unreachable_goal_and_start_equal_to_goal():
+    occ = np.zeros((6, 12), dtype=bool)
+    occ[:, 5:7] = True  # a full wall
+    ws = Workspace(occ)
+    plan = plan_heat(ws, [Pose(1, 1, "O", 0), Pose(9, 1, "O", 0)])
+    assert not plan.reached and plan.failed_leg == 0 and len(plan.commands) == 0
+    same = plan_heat(ws, [Pose(1, 1, "O", 0), Pose(1, 1, "O", 0)])
+    assert same.reached and len(same.commands) == 0 and same.time == 0.0
+    assert same.info["fitness"] == {"f_t": 1.0, "f_sm": 1.0, "f_sf": 1.0, "f": 1.0}
+
+
+def test_plan_path_routes_heat():
+    scenario = load_scenario("three_slit")
+    plan = plan_path(scenario.workspace, scenario.roadmap, method="heat", weights=(1, 0, 1), element="p0")
+    assert plan.method == "heat" and plan.reached and plan.info["field"][0]["element"] == "p0"
+    with pytest.raises(ParameterError, match="no option 'pop_size'"):
+        plan_path(scenario.workspace, scenario.roadmap, method="heat", pop_size=10)
+
+
+def test_default_commands_are_do_et_al_s_seventeen():
+    scenario = load_scenario("random")
+    plan = plan_heat(scenario.workspace, scenario.roadmap)
+    assert set(plan.commands.tolist()) <= set(command_set(diagonals=True))
+    assert any(COMMANDS[int(c)].kind == "diagonal" for c in plan.commands)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"weights": (1, 0)}, "three numbers"),
+    ({"weights": (0, 0, 0)}, "not all be zero"),
+    ({"weights": (1, -1, 0)}, "w_sm"),
+    ({"weights": (1, float("nan"), 0)}, "w_sm"),
+    ({"weights": (1, 1, 0)}, "not available yet"),
+    ({"t_max": 0}, "t_max"),
+    ({"t_max": float("inf")}, "t_max"),
+    ({"element": "p2"}, "unknown element"),
+    ({"monotone": "yes"}, "monotone"),
+    ({"field_options": {"nope": 1}}, "nope"),
+    ({"commands": ["x+", "x-", "y+", "y-", "1l"]}, "block commands"),
+])
+def test_bad_inputs_raise_typed_errors(kwargs, match):
+    ws = Workspace(np.zeros((6, 6), dtype=bool))
+    with pytest.raises(ParameterError, match=match):
+        plan_heat(ws, [Pose(1, 1, "O", 0), Pose(3, 3, "O", 0)], **kwargs)
+
+
+def test_moving_obstacles_and_short_roadmaps_are_refused():
+    dynamic = load_scenario("perpendicular_dynamic")
+    with pytest.raises(ParameterError, match="static maps only: use dijkstra"):
+        plan_heat(dynamic.workspace, dynamic.roadmap)
+    with pytest.raises(PlanningError):
+        plan_heat(Workspace(np.zeros((6, 6), dtype=bool)), [Pose(1, 1, "O", 0)])
