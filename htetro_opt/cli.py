@@ -52,6 +52,16 @@ GA_DEFAULTS = {"pop_size": 50, "max_gen": 1000, "patience": 100, "max_length": N
 TILING_TIME_LIMIT = 60.0  # the backtracker can search long on cluttered maps with few allowed shapes
 
 
+def _add_outputs(p, *, json: str = "print one JSON object", plot: str | None = None, gif: str | None = None) -> None:
+    """The output options every command shares: --json, --quiet, and --plot / --gif where it draws."""
+    p.add_argument("--json", action="store_true", help=json)
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
+    if plot:
+        p.add_argument("--plot", metavar="FILE", help=f"save {plot} (format from the extension)")
+    if gif:
+        p.add_argument("--gif", metavar="FILE", help=f"save {gif}")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(prog="htetro-opt", description="Path planning for the hTetro reconfigurable robot.",
                     epilog="The robot model, the scenario and tileset formats and the JSON output are described in "
@@ -61,8 +71,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", parser_class=Parser, metavar="COMMAND")
 
     p = sub.add_parser("scenarios", help="list the bundled scenarios")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
+    _add_outputs(p)
 
     p = sub.add_parser("plan", help="plan a path through a scenario's roadmap")
     p.add_argument("scenario", help="bundled scenario name or path to a scenario TOML file")
@@ -93,10 +102,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-monotone", action="store_true",
                    help="heat: drop the rule that translations never go down the temperature field")
     p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block (default 0)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
-    p.add_argument("--plot", metavar="FILE", help="save a plot of the map and the path (format from the extension)")
-    p.add_argument("--gif", metavar="FILE", help="save an animated GIF of the plan, step by step")
+    _add_outputs(p, plot="a plot of the map and the path", gif="an animated GIF of the plan, step by step")
 
     p = sub.add_parser(
         "simulate",
@@ -110,10 +116,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--commands", required=True,
                    help='comma- or space-separated tokens, e.g. "x+,x+,sI"; @FILE reads them from a file, - from stdin')
     p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
-    p.add_argument("--plot", metavar="FILE", help="save a plot of the map and the executed path")
-    p.add_argument("--gif", metavar="FILE", help="save an animated GIF of the executed commands, step by step")
+    _add_outputs(p, plot="a plot of the map and the executed path",
+                 gif="an animated GIF of the executed commands, step by step")
 
     p = sub.add_parser(
         "tile",
@@ -133,9 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--time-limit", type=float, default=TILING_TIME_LIMIT,
                    help=f"give up after this many seconds (default {TILING_TIME_LIMIT:g})")
     p.add_argument("--out", metavar="FILE", help="write the labelled tileset to FILE")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
-    p.add_argument("--plot", metavar="FILE", help="save a plot of the tileset (format from the extension)")
+    _add_outputs(p, plot="a plot of the tileset")
 
     p = sub.add_parser(
         "sequence",
@@ -157,9 +159,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--time-limit", type=float,
                    help=f"time budget in seconds; by default, sized to the instance: {TIME_LIMIT_TEXT}")
     p.add_argument("--shapes", help="when TILESET is a scenario: allowed morphologies for the tiling")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
-    p.add_argument("--plot", metavar="FILE", help="save a plot of the tileset and the order (format from the extension)")
+    _add_outputs(p, plot="a plot of the tileset and the order")
     p = sub.add_parser(
         "study",
         help="run a study (scenarios x methods x seeds) and summarise it",
@@ -180,8 +180,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--retries", type=int, default=0, help="re-run a failing trial up to N times (default 0)")
     p.add_argument("--time-limit", type=float,
                    help="seed003 only: cap in seconds for each method that takes one (a study file sets its own)")
-    p.add_argument("--json", action="store_true", help="print one JSON object instead of the summary table")
-    p.add_argument("--quiet", action="store_true", help="no progress on stderr (shown only on a terminal)")
+    _add_outputs(p, json="print one JSON object instead of the summary table")
     return parser
 
 

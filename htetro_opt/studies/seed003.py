@@ -11,7 +11,7 @@ tiles' waypoints by its GA and by zigzag, spiral and greedy baselines, and repor
 - **Tables 4–5**: a coverage simulation on 11 × 11: distance travelled by the blocks, average grid
   coverage time and the share of re-covered cells at heat-map thresholds 150 and 100.
 
-:func:`run_study` re-runs all of it on the paper's own labelled tilesets (bundled, transcribed from
+:func:`run_seed003` (with :func:`report`) re-runs all of it on the paper's own labelled tilesets (bundled, transcribed from
 its figures) and on tilings of ours, with every method of :mod:`htetro_opt.solvers.sequencing`, and
 adds what the paper could not report: each method's gap to the proven optimum (the exact method).
 The paper's numbers sit beside ours (``PAPER_*``). Its tables do not say from which tile its paths
@@ -78,7 +78,6 @@ __all__ = [
     "run_table2",
     "run_table3",
     "run_table45",
-    "run_study",
     "markdown_report",
     "write_csv",
 ]
@@ -251,27 +250,6 @@ def run_table45(tileset: Tileset, table1: Iterable[dict]) -> list[dict]:
         "recovered_150": float(coverage.recovered(150, scale=scale)),
         "recovered_100": float(coverage.recovered(100, scale=scale)),
     } for row, coverage in runs]
-
-
-def run_study(*, seeds: Iterable[int] = range(5), time_limit: float | None = None, progress=None) -> list[dict]:
-    """Tables 1–5 in one list of records (see the module docstring)."""
-    seeds = _check_seeds(seeds)
-    say = progress or (lambda message: None)
-    records: list[dict] = []
-    table1_tilesets = [paper_tileset("paper_11x11_fig13d")]
-    ours = tile_workspace(load_scenario("tiling_11x11").workspace, name="ours tiling_11x11 (backtracking)")
-    table1_tilesets.append(Tileset(ours.occupancy, ours.blocks, ours.ids, 0.25, ours.name))
-    for ts in table1_tilesets:
-        say(f"Table 1 on {ts.name}")
-        rows = run_table1(ts, seeds=seeds, time_limit=time_limit)
-        records += rows
-        say(f"Tables 4-5 on {ts.name}")
-        records += run_table45(ts, rows)
-    say("Table 2 on paper_10x10_fig13c")
-    records += run_table2(paper_tileset("paper_10x10_fig13c"))
-    say("Table 3")
-    records += run_table3(seeds=seeds[:2])
-    return records
 
 
 def _fmt(value, digits: int = 3) -> str:
@@ -454,7 +432,8 @@ def _reference(record: Mapping[str, Any], references: Sequence[Mapping[str, Any]
 
 
 def _legacy_records(run: StudyRun) -> list[dict]:
-    """The runner's records as :func:`run_study`'s (Tables 1, 2 and 4), for :func:`markdown_report`."""
+    """The runner's records in :func:`run_table1`'s and :func:`run_table2`'s form (Tables 1, 2 and 4),
+    for :func:`markdown_report`."""
     records: list[dict] = []
     table1: dict[str, list[dict]] = {}
     table2: list[dict] = []

@@ -306,8 +306,8 @@ def dask_processes(tmp_path):
         for process in reversed(started):
             process.terminate()
         for process in started:
-            try:
-                process.wait(timeout=10)
+            try:  # a worker keeps trying to reach a scheduler that is gone: do not wait for it long
+                process.wait(timeout=2)
             except subprocess.TimeoutExpired:
                 process.kill()
                 process.wait()
