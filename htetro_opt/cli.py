@@ -94,13 +94,19 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"GA methods: random seed, the same seed giving the same plan (default {GA_DEFAULTS['seed']})")
     p.add_argument("--diagonals", action="store_true", help="dijkstra, astar: allow diagonal translations")
     p.add_argument("--weights", metavar="WT,WSM,WSF",
-                   help="heat: weights of time, smoothness and safety (default 1,0,0; smoothness not yet available)")
+                   help="heat: weights of time, smoothness and safety (default 1,0,0)")
     p.add_argument("--t-max", type=float, metavar="S",
                    help="heat: t_max of f_t in seconds (default: half an O-shape boustrophedon of the empty map)")
     p.add_argument("--element", choices=("q1", "p0"),
                    help="heat: the field's element, bilinear q1 (default, the paper's) or cell-centred p0")
     p.add_argument("--no-monotone", action="store_true",
                    help="heat: drop the rule that translations never go down the temperature field")
+    p.add_argument("--band", metavar="auto|full|R",
+                   help="heat: search the whole pose graph (full), or a band of R cells around the field's ascent "
+                        "line, widened until a path is found (default auto: full up to 4 million poses, else R 8)")
+    p.add_argument("--sensor-range", type=float, metavar="R",
+                   help="heat: run in the true world (hidden obstacles), sensing cells within R cells of the blocks "
+                        "and replanning when the plan meets a new obstacle (Do et al. 2021: 6)")
     p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block (default 0)")
     _add_outputs(p, plot="a plot of the map and the path", gif="an animated GIF of the plan, step by step")
 
@@ -307,8 +313,9 @@ def _cmd_plan(args) -> dict:
     genetic = args.method not in EXACT_METHODS and not heat
     given = {name: getattr(args, name) for name in GA_DEFAULTS if getattr(args, name) is not None}
     heat_given = [flag for flag, value in (("--weights", args.weights), ("--t-max", args.t_max),
-                                           ("--element", args.element), ("--no-monotone", args.no_monotone))
-                  if value]
+                                           ("--element", args.element), ("--no-monotone", args.no_monotone),
+                                           ("--band", args.band), ("--sensor-range", args.sensor_range))
+                  if value is not None and value is not False]
     if heat_given and not heat:
         raise ParameterError(f"{', '.join(heat_given)} applies to --method heat only")
     if heat:
@@ -321,6 +328,12 @@ def _cmd_plan(args) -> dict:
             options["t_max"] = check_real(args.t_max, "--t-max (seconds)", minimum=0.0, include_minimum=False)
         if args.element:
             options["element"] = args.element
+        if args.band is not None:
+            options["band"] = args.band if args.band in ("auto", "full") else _band_radius(args.band)
+        if args.sensor_range is not None:
+            check_real(args.sensor_range, "--sensor-range (cells)", minimum=0.0, include_minimum=False)
+        if args.plot:
+            options["keep_fields"] = True
     elif genetic:
         if args.diagonals:
             raise ParameterError(f"--diagonals is not available with --method {args.method} "
@@ -342,7 +355,11 @@ def _cmd_plan(args) -> dict:
     with console.step(f"planning ({args.method})", options.get("max_gen"), "generations") as progress:
         if genetic:
             options["progress"] = progress
-        plan = plan_path(scenario.workspace, scenario.roadmap, method=args.method, clearance=clearance, **options)
+        if heat and args.sensor_range is not None:
+            plan, run = _replanned(scenario, args.sensor_range, clearance, options)
+        else:
+            plan, run = plan_path(scenario.workspace, scenario.roadmap, method=args.method, clearance=clearance,
+                                  **options), None
     out = {
         "scenario": scenario.name,
         "method": plan.method,
@@ -355,8 +372,11 @@ def _cmd_plan(args) -> dict:
     if genetic:
         out.update(_ga_fields(plan, args))
     if heat:
-        out.update({key: plan.info[key] for key in ("fitness", "weights", "t_max", "relaxed", "field")
+        out.update({key: plan.info[key] for key in ("fitness", "weights", "t_max", "relaxed", "surrogate", "band", "field")
                     if key in plan.info})
+        if run is not None:
+            record = run.as_dict()
+            out.update({key: record[key] for key in ("sensor_range", "plans", "replans")})
     if args.plot:
         from htetro_opt.viz import plot_ga_plan, plot_path
 
@@ -367,6 +387,13 @@ def _cmd_plan(args) -> dict:
             def figure():
                 return plot_ga_plan(scenario.workspace, plan, roadmap=scenario.roadmap, hidden=scenario.hidden,
                                     title=title)
+        elif heat and plan.info.get("fields"):
+            from htetro_opt.viz import plot_heat_plan
+
+            def figure():
+                return plot_heat_plan(scenario.workspace, plan, plan.info["fields"],
+                                      replans=run.replans if run is not None else None, roadmap=scenario.roadmap,
+                                      hidden=scenario.hidden, title=title)
         else:
             def figure():
                 return plot_path(scenario.workspace, plan.poses, roadmap=scenario.roadmap, hidden=scenario.hidden,
@@ -506,6 +533,28 @@ def _cmd_tile(args) -> dict:
     else:
         print(format_tileset(tileset))
     return out
+
+
+def _band_radius(text: str) -> int:
+    """``--band R``: a radius in cells (``auto`` and ``full`` are taken before)."""
+    try:
+        return check_int(int(text), "--band radius", minimum=1)
+    except ValueError:
+        raise ParameterError(f"--band must be auto, full or a radius in cells (an integer >= 1), got {text!r}") from None
+
+
+def _replanned(scenario, sensor_range: float, clearance: float, options: dict):
+    """Do et al. 2021's run in the true world, replanning on what the robot senses, as a plan (its
+    executed commands) and the run itself."""
+    from htetro_opt.solvers.grid_paths import Plan, replan_heat
+
+    run = replan_heat(scenario, sensor_range=sensor_range, clearance=clearance, **options)
+    plan = Plan(method="heat (replanning)", commands=run.executed, reached=run.reached, time=run.time,
+                poses=run.poses, leg_ends=(len(run.executed),) if run.reached else (),
+                failed_leg=-1 if run.reached else 0, runtime_s=run.runtime_s,
+                info={"fitness": run.fitness, "weights": run.info["weights"], "t_max": run.info["t_max"],
+                      "fields": run.fields})
+    return plan, run
 
 
 def _heat_weights(text: str | None) -> tuple[float, float, float]:

@@ -998,6 +998,12 @@ def test_plan_heat_json_and_replay(capsys):
     (["--method", "heat", "--t-max", "-1"], ["--t-max"]),
     (["--t-max", "5"], ["--t-max", "heat"]),
     (["--method", "htetro-ga", "--element", "p0"], ["--element", "heat"]),
+    (["--method", "heat", "--band", "0"], ["--band"]),
+    (["--method", "heat", "--band", "wide"], ["--band"]),
+    (["--band", "4"], ["--band", "heat"]),
+    (["--method", "heat", "--sensor-range", "0"], ["--sensor-range"]),
+    (["--method", "heat", "--sensor-range", "2"], ["sensor_range", "3.162"]),
+    (["--sensor-range", "6"], ["--sensor-range", "heat"]),
 ])
 def test_plan_heat_bad_options(capsys, argv, words):
     assert_one_error_line(*run(capsys, ["plan", "h_shape", *argv]), *words)
@@ -1005,3 +1011,25 @@ def test_plan_heat_bad_options(capsys, argv, words):
 
 def test_plan_heat_refuses_moving_obstacles(capsys):
     assert_one_error_line(*run(capsys, ["plan", "parallel_dynamic", "--method", "heat"]), "static")
+
+
+def test_plan_heat_band_and_weights_in_the_json(capsys):
+    whole = run_json(capsys, ["plan", "maze", "--method", "heat", "--weights", "1,1,1", "--json"])
+    banded = run_json(capsys, ["plan", "maze", "--method", "heat", "--weights", "1,1,1", "--band", "2", "--json"])
+    assert whole["band"][0]["radius"] is None and banded["band"][0]["radius"] >= 2
+    assert banded["band"][0]["cells"] < whole["band"][0]["cells"]
+    assert banded["surrogate"][0] >= whole["surrogate"][0] - 1e-12  # a band is part of the whole graph
+    replay = run_json(capsys, ["simulate", "maze", "--commands", ",".join(banded["commands"]), "--json"])
+    assert replay["reached"] is True and replay["time"] == pytest.approx(banded["time"])
+
+
+def test_plan_heat_with_a_sensor_replans_in_the_true_world(capsys, tmp_path):
+    png = tmp_path / "heat.png"
+    out = run_json(capsys, ["plan", "maze_partial", "--method", "heat", "--sensor-range", "6", "--json",
+                            "--plot", str(png)])
+    assert out["reached"] is True and out["plans"] == len(out["replans"]) + 1 >= 2
+    assert {"step", "pose", "revealed"} <= set(out["replans"][0])
+    # simulate runs in the true world (hidden obstacles included): the executed commands are valid there
+    replay = run_json(capsys, ["simulate", "maze_partial", "--commands", ",".join(out["commands"]), "--json"])
+    assert replay["reached"] is True and replay["time"] == pytest.approx(out["time"])
+    assert png.stat().st_size > 10_000 and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -17,7 +17,7 @@ from htetro_opt.model.commands import (
 )
 from htetro_opt.model.coverage import CoverageResult, simulate_coverage
 from htetro_opt.model.robot import FOOTPRINTS, N_NAMED, N_STATES, SHAPES, STATE_NAMES, Pose, block_poses, shape_index
-from htetro_opt.model.simulate import SimulationResult, Simulator, simulate
+from htetro_opt.model.simulate import SimulationResult, Simulator, simulate, transitions_at
 from htetro_opt.model.sweeps import SweepTables, sweep_tables
 from htetro_opt.model.workspace import MovingObstacle, Workspace, grid_distance
 
@@ -25,7 +25,7 @@ __all__ = [
     "COMMANDS", "DIAGONAL_COMMANDS", "SEED000_COMMANDS", "SEED004_COMMANDS", "TOKENS", "Command", "Timing",
     "command_id", "command_set", "format_commands", "parse_commands",
     "FOOTPRINTS", "N_NAMED", "N_STATES", "SHAPES", "STATE_NAMES", "Pose", "block_poses", "shape_index",
-    "SimulationResult", "Simulator", "simulate", "SweepTables", "sweep_tables",
+    "SimulationResult", "Simulator", "simulate", "transitions_at", "SweepTables", "sweep_tables",
     "MovingObstacle", "Workspace", "grid_distance",
     "CoverageResult", "simulate_coverage",
 ]

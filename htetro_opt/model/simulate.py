@@ -7,7 +7,8 @@ inside the map and free, and an extra ``pad`` command leaves every pose unchange
 is then one add and one gather per step for the whole batch: the table is kept premultiplied by its
 column count, so a gathered value plus the next command is the next index. Moving obstacles add, per
 time step, a sorted array of blocked ``pose * n_columns + command`` keys (the swept-cell table turned
-inside out), checked with one ``searchsorted`` per step.
+inside out), checked with one ``searchsorted`` per step. :func:`transitions_at` gives the table's rows
+at some cells only, from the same sweep check, for maps whose whole table would not fit in memory.
 
 Time for moving obstacles is the number of commands executed (MODEL.md §5): command number t (from 0,
 counted from ``t0``) must keep its swept cells clear of every cell a moving obstacle covers between
@@ -41,7 +42,7 @@ from htetro_opt.model.sweeps import SweepTables, sweep_tables
 from htetro_opt.model.workspace import Workspace, check_workspace, describe_cells
 
 __all__ = ["Simulator", "SimulationResult", "simulate", "MEMORY_BUDGET", "memory_budget", "table_shape",
-           "compile_bytes", "cells_within", "map_text", "size_text", "check_memory"]
+           "compile_bytes", "cells_within", "map_text", "size_text", "check_memory", "transitions_at"]
 
 _STOP = command_id("stop")
 
@@ -94,6 +95,42 @@ def _states_of(ids) -> int:
     """Number of robot states a command set reaches: the intermediate ones only with block commands."""
     uses_blocks = any(COMMANDS[c].kind == "block" and any(COMMANDS[c].hinge_delta) for c in ids)
     return N_STATES if uses_blocks else N_NAMED
+
+
+def _sweep_validity(tables: SweepTables, command_ids: np.ndarray, n_states: int, free_at) -> np.ndarray:
+    """``valid[state, heading, command, *cells]``: MODEL.md §4's check of a command set at some B2 cells.
+
+    The one implementation of the sweep check, for the :class:`Simulator`'s whole map and for
+    :func:`transitions_at`'s cells: ``free_at(offsets)`` takes the ``(D, 2)`` distinct swept-cell
+    offsets ``(ox, oy)`` and returns, shape ``(D, *cells)``, whether the cell at each offset from each
+    B2 cell is inside the map and free. A command is valid where it is legal in the state and all its
+    swept cells are free.
+    """
+    offsets = tables.offsets[:n_states, :, command_ids]  # (S, 4, C, K, 2)
+    # One integer key per offset: np.unique(axis=0) sorts the rows as structured values, far slower.
+    span = int(np.abs(offsets).max())
+    base = 2 * span + 1
+    keys, inverse = np.unique((offsets[..., 0] + span) * base + offsets[..., 1] + span, return_inverse=True)
+    distinct = np.column_stack([keys // base - span, keys % base - span])  # (D, 2) of (ox, oy)
+    shifted = free_at(distinct)
+    which = inverse.reshape(offsets.shape[:-1])
+    valid = shifted[which[..., 0]]
+    for k in range(1, which.shape[-1]):
+        valid &= shifted[which[..., k]]
+    legal = tables.legal[:n_states, command_ids]
+    valid &= legal.reshape(legal.shape[0], 1, legal.shape[1], *(1,) * (shifted.ndim - 1))
+    return valid
+
+
+def _target_entries(tables: SweepTables, command_ids: np.ndarray, n_states: int, height: int,
+                    width: int) -> np.ndarray:
+    """``(S, 4, C)`` target pose id minus the start cell's ``y * W + x``: with the pose ids
+    ``((state' * 4 + heading') * H + y + dy) * W + x + dx`` split into a per-(state, heading, command)
+    part and a per-cell part. Meaningless where the command is illegal or invalid: callers mask those."""
+    target_state = tables.next_state[:n_states][:, command_ids].clip(0)  # (S, C)
+    target_heading = tables.next_heading[:n_states][:, :, command_ids]  # (S, 4, C)
+    dx, dy = tables.shift[command_ids, 0], tables.shift[command_ids, 1]
+    return ((target_state[:, None, :] * N_HEADINGS + target_heading) * height + dy) * width + dx
 
 
 def table_shape(workspace: Workspace, *, commands=None, diagonals: bool = False) -> tuple[int, int]:
@@ -315,36 +352,25 @@ class Simulator:
     # --- compilation -------------------------------------------------------------------------
     def _valid_table(self, free: np.ndarray) -> np.ndarray:
         """valid[state, heading, command, y, x] for a free-cell map (True = free)."""
-        t = self.tables
-        offsets = t.offsets[: self.n_states, :, self.command_ids]  # (S, 4, C, K, 2)
-        margin = int(np.abs(offsets).max()) + 1
         h, w = free.shape
-        framed = np.zeros((h + 2 * margin, w + 2 * margin), dtype=bool)  # outside the map is blocked
-        framed[margin : margin + h, margin : margin + w] = free
-        distinct, inverse = np.unique(offsets.reshape(-1, 2), axis=0, return_inverse=True)
-        shifted = np.stack([
-            framed[margin + oy : margin + oy + h, margin + ox : margin + ox + w] for ox, oy in distinct
-        ])
-        which = inverse.reshape(offsets.shape[:-1])
-        valid = shifted[which[..., 0]]
-        for k in range(1, which.shape[-1]):
-            valid &= shifted[which[..., k]]
-        legal = t.legal[: self.n_states, self.command_ids]
-        valid &= legal[:, None, :, None, None]
-        return valid
+
+        def free_at(offsets: np.ndarray) -> np.ndarray:
+            # Whole-map shifts are slices of the map framed by blocked cells: no index arrays of map size.
+            margin = int(np.abs(offsets).max()) + 1
+            framed = np.zeros((h + 2 * margin, w + 2 * margin), dtype=bool)  # outside the map is blocked
+            framed[margin : margin + h, margin : margin + w] = free
+            return np.stack([framed[margin + oy : margin + oy + h, margin + ox : margin + ox + w]
+                             for ox, oy in offsets])
+
+        return _sweep_validity(self.tables, self.command_ids, self.n_states, free_at)
 
     def _transition_table(self) -> np.ndarray:
-        t, ws = self.tables, self.workspace
+        ws = self.workspace
         h, w, S, C = ws.height, ws.width, self.n_states, self.n_commands
         dtype = _table_dtype(self.n_poses, self.n_commands)
         blocked = self._valid_table(~ws.occupancy).transpose(0, 1, 3, 4, 2)  # (S, 4, H, W, C)
         np.logical_not(blocked, out=blocked)
-        target_state = t.next_state[:S][:, self.command_ids].clip(0)  # (S, C)
-        target_heading = t.next_heading[:S][:, :, self.command_ids]  # (S, 4, C)
-        dx, dy = t.shift[self.command_ids, 0], t.shift[self.command_ids, 1]
-        # pose id of the target = ((state' * 4 + heading') * H + y + dy) * W + x + dx, split into a
-        # per-(state, heading, command) part and a per-cell part; out-of-map targets are masked by `ok`.
-        entry = ((target_state[:, None, :] * N_HEADINGS + target_heading) * h + dy) * w + dx
+        entry = _target_entries(self.tables, self.command_ids, S, h, w)
         cell = np.arange(h * w, dtype=dtype).reshape(h, w)
         table = np.empty((self.n_poses + 1, self.n_columns), dtype=dtype)
         view = table[:-1, :C].reshape(S, N_HEADINGS, h, w, C)
@@ -680,3 +706,115 @@ def simulate(workspace: Workspace, sequences, start: Pose, **options) -> Simulat
     compile_keys = {"commands", "diagonals", "timing", "clearance"}
     sim = Simulator(workspace, **{k: v for k, v in options.items() if k in compile_keys})
     return sim.run(sequences, start, **{k: v for k, v in options.items() if k not in compile_keys})
+
+
+def transitions_at(
+    workspace: Workspace,
+    cells,
+    *,
+    commands: Iterable[str | int] | None = None,
+    diagonals: bool = False,
+    clearance: float = 0.0,
+) -> np.ndarray:
+    """Next pose of every (state, heading, command) at some B2 cells: rows of the :class:`Simulator`'s
+    table without compiling it for the whole map.
+
+    ``transitions_at(workspace, cells)[i, state, heading, j]`` is the :class:`Simulator`'s
+    ``next[pose, j]`` for the pose ``(x, y, state, heading)`` of ``cells[i] = (x, y)``, with −1 for
+    its ``dead``: the flat pose id ``((state' * 4 + heading') * H + y') * W + x'`` of the whole map
+    (:meth:`Simulator.encode`'s numbering) after command j, or −1 where the command is not legal in
+    the state or its swept cells (with clearance δ, MODEL.md §4) are not all inside the map and
+    free. The Simulator's table is the all-cells case and comes from the same sweep check; this
+    function takes memory in proportion to ``len(cells)`` only (beyond the workspace itself), for
+    searches on maps whose full table would not fit (1.6 GB for the table alone at 1000 x 1000 with the
+    default commands, :func:`compile_bytes`).
+
+    Only the static occupancy counts: moving obstacles are ignored, as in the Simulator's ``next``
+    table (its runs check them apart, per time step).
+
+    Parameters
+    ----------
+    workspace : Workspace
+    cells : array_like of int, shape (n, 2)
+        B2 cells ``(x, y)`` inside the map; repeats are allowed.
+    commands : iterable of str or int, optional, keyword-only
+        Command tokens or ids, resolved as :class:`Simulator` resolves them: Cheng et al. 2020's set
+        by default (plus the diagonals when ``diagonals``); Cheng et al. 2019's block commands bring
+        in the 16 intermediate states.
+    diagonals : bool, keyword-only
+        Add the four diagonal translations to the default set.
+    clearance : float, keyword-only
+        δ in cells (MODEL.md §4).
+
+    Returns
+    -------
+    ndarray of int64, shape (n, n_states, 4, n_commands)
+        Target pose ids, −1 where invalid. ``n_states`` is 7, or 23 with block commands; the
+        commands are in the order of the command set (a :class:`Simulator`'s ``command_ids``,
+        :func:`command_set` for the default sets).
+
+    Raises
+    ------
+    ParameterError
+        If ``cells`` is not an (n, 2) array of integers, a cell lies outside the map, ``workspace``
+        is not a Workspace, or an option is invalid.
+    UnknownCommandError
+        If a command is not in the vocabulary.
+
+    Examples
+    --------
+    >>> from htetro_opt.model import shape_index
+    >>> ws = Workspace(np.zeros((5, 5), dtype=bool))
+    >>> ids = transitions_at(ws, [(1, 2), (3, 2)], commands="x+,x-")
+    >>> ids.shape  # 2 cells, 7 shapes, 4 headings, 2 commands
+    (2, 7, 4, 2)
+    >>> ids[:, shape_index("O"), 0]  # the O is two cells wide: x+ from x = 3 would leave the map
+    array([[112, 110],
+           [ -1, 112]])
+    >>> sim = Simulator(ws, commands="x+,x-")
+    >>> sim.next[sim.encode(Pose(1, 2, "O", 0)), :2].tolist()
+    [112, 110]
+    """
+    check_workspace(workspace)
+    ids = np.array(_resolve_commands(commands, diagonals), dtype=np.int64)
+    tables = sweep_tables(clearance)
+    xy = _check_cells(cells, workspace)
+    h, w = workspace.height, workspace.width
+    n_states = _states_of(ids.tolist())
+    occupied = workspace.occupancy
+    x, y = xy[:, 0], xy[:, 1]
+
+    def free_at(offsets: np.ndarray) -> np.ndarray:
+        px, py = x[None, :] + offsets[:, :1], y[None, :] + offsets[:, 1:]  # (D, n)
+        free = (px >= 0) & (px < w) & (py >= 0) & (py < h)
+        free &= ~occupied[py.clip(0, h - 1), px.clip(0, w - 1)]
+        return free
+
+    valid = _sweep_validity(tables, ids, n_states, free_at)  # (S, 4, C, n)
+    out = _target_entries(tables, ids, n_states, h, w)[None] + (y * w + x)[:, None, None, None]
+    np.copyto(out, -1, where=~valid.transpose(3, 0, 1, 2))
+    return out
+
+
+def _check_cells(cells, workspace: Workspace) -> np.ndarray:
+    """``cells`` as an (n, 2) int64 array of (x, y) cells inside the workspace."""
+    try:
+        array = np.asarray(cells)
+    except (TypeError, ValueError) as err:  # ragged rows
+        raise ParameterError(f"cells must be an (n, 2) array of (x, y) cells, got {reprlib.repr(cells)}") from err
+    if array.shape == (0,):
+        return np.empty((0, 2), dtype=np.int64)
+    if array.ndim != 2 or array.shape[1] != 2:
+        one = " (one cell is [(x, y)])" if array.shape == (2,) else ""
+        raise ParameterError(f"cells must be an (n, 2) array of (x, y) cells{one}, got shape {array.shape}: "
+                             f"{reprlib.repr(cells)}")
+    if array.size and array.dtype.kind not in "iu":
+        raise ParameterError(f"cells must hold integer (x, y) cells, got an array of {array.dtype}: "
+                             f"{reprlib.repr(cells)}")
+    x, y = array[:, 0], array[:, 1]
+    outside = (x < 0) | (x >= workspace.width) | (y < 0) | (y >= workspace.height)
+    if outside.any():
+        first = int(np.flatnonzero(outside)[0])
+        raise ParameterError(f"cells must lie inside the {workspace.width} x {workspace.height} map; outside it: "
+                             f"{describe_cells(array[outside])} (the first at cells[{first}])")
+    return array.astype(np.int64, copy=False)

@@ -11,9 +11,15 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from htetro_opt.errors import ConfigurationError, PlanningError, UnknownCommandError
+from htetro_opt.errors import (
+    ConfigurationError,
+    ParameterError,
+    PlanningError,
+    UnknownCommandError,
+)
 from htetro_opt.model import (
     COMMANDS,
+    SEED004_COMMANDS,
     STATE_NAMES,
     MovingObstacle,
     Pose,
@@ -25,6 +31,7 @@ from htetro_opt.model import (
     shape_index,
     simulate,
     sweep_tables,
+    transitions_at,
 )
 
 ALL_TOKENS = [c.token for c in COMMANDS]
@@ -333,3 +340,152 @@ def test_array_holding_objects_compare_by_identity_and_hash():
     a, b = Workspace(np.zeros((3, 3), dtype=bool)), Workspace(np.zeros((3, 3), dtype=bool))
     assert a == a and a != b
     assert len({a, b, MovingObstacle(np.array([[0, 0]]), np.array([[1, 0]]))}) == 3
+
+
+# --- transitions_at: the simulator's rows at some cells, without the whole table ----------------------
+
+SEED004 = list(SEED004_COMMANDS)
+
+
+def simulator_rows(sim, cells):
+    """The simulator's next poses of every (state, heading, command) at ``cells``, ``dead`` as −1."""
+    ws = sim.workspace
+    states, headings = np.meshgrid(np.arange(sim.n_states), np.arange(4), indexing="ij")
+    rows = np.empty((len(cells), sim.n_states, 4, sim.n_commands), dtype=np.int64)
+    for i, (x, y) in enumerate(cells):
+        ids = ((states * 4 + headings) * ws.height + y) * ws.width + x
+        rows[i] = sim.next[ids, : sim.n_commands]
+    rows[rows == sim.dead] = -1
+    return rows
+
+
+@pytest.mark.parametrize(
+    ("size", "density", "clearance", "options"),
+    [
+        ((9, 7), 0.1, 0.0, {}),
+        ((12, 10), 0.2, 0.3, {"diagonals": True}),
+        ((15, 6), 0.05, 0.5, {"commands": SEED004}),
+        ((11, 13), 0.15, 0.3, {"commands": SEED004 + ["x+y+", "x-y-", "sI", "sT"]}),
+        ((20, 17), 0.3, 0.0, {"commands": ALL_TOKENS}),
+        ((6, 1), 0.0, 0.5, {}),  # one row: every footprint at heading 0 leaves the map
+    ],
+)
+def test_transitions_at_rows_are_the_simulators_rows(size, density, clearance, options):
+    rng = np.random.default_rng(sum(size) + int(10 * clearance))
+    width, height = size
+    ws = Workspace(rng.random((height, width)) < density)
+    sim = Simulator(ws, clearance=clearance, **options)
+    cells = np.column_stack([rng.integers(0, width, 40), rng.integers(0, height, 40)])  # repeats included
+    rows = transitions_at(ws, cells, clearance=clearance, **options)
+    assert rows.shape == (40, sim.n_states, 4, sim.n_commands) and rows.dtype == np.int64
+    assert np.array_equal(rows, simulator_rows(sim, cells))
+    if height > 1:
+        assert (rows >= 0).any() and (rows == -1).any()  # both outcomes are compared
+
+
+def test_transitions_at_every_cell_is_the_simulators_whole_table():
+    ws = Workspace(random_map(np.random.default_rng(2), 10, 8, 0.2))
+    sim = Simulator(ws, commands=SEED004, clearance=0.3)
+    cells = np.argwhere(np.ones((8, 10), dtype=bool))[:, ::-1]
+    rows = transitions_at(ws, cells, commands=SEED004, clearance=0.3)
+    table = sim.next[: sim.n_poses, : sim.n_commands].astype(np.int64)
+    table[table == sim.dead] = -1
+    expected = table.reshape(sim.n_states, 4, 8, 10, sim.n_commands).transpose(2, 3, 0, 1, 4).reshape(rows.shape)
+    assert np.array_equal(rows, expected)
+    assert rows.shape[1] == 23
+
+
+def test_transitions_at_by_hand_from_the_model_geometry():
+    """MODEL.md §2's footprints and numbering on a 5 x 4 map, read off by hand."""
+    occ = np.zeros((4, 5), dtype=bool)
+    occ[1, 4] = True  # cell (4, 1)
+    ws = Workspace(occ)
+    W, H, o = 5, 4, shape_index("O")
+    own = ((o * 4 + 0) * H + 1) * W + 2  # O at (2, 1), heading 0: blocks (2, 0), (2, 1), (3, 1), (3, 0)
+    rows = transitions_at(ws, [(2, 1), (1, 1)], commands=["x+", "x-", "y+", "y-", "r+"])
+    assert rows[0, o, 0].tolist() == [
+        -1,  # x+ puts B3 on the obstacle (4, 1)
+        own - 1,  # x-: one cell left
+        own + W,  # y+: one row up
+        -1,  # y-: B1 and B4 would leave the map below
+        -1,  # r+: the turning blocks sweep cells below the map
+    ]
+    assert rows[1, o, 0, 0] == own  # from (1, 1), x+ lands on (2, 1)
+    corner = transitions_at(ws, [(3, 3)], commands=["x+", "x-", "y+", "y-"])[0, o, 0]  # blocks (3..4, 2..3)
+    # x+ and y+ leave the map, x- lands on (2, 3), y- puts B4 on the obstacle (4, 1)
+    assert corner.tolist() == [-1, own + 2 * W, -1, -1]
+    # In an empty 7 x 7 map, the centre is far enough from every edge for a turn and a shapeshift.
+    big = transitions_at(Workspace(np.zeros((7, 7), dtype=bool)), [(3, 3), (0, 0)], commands=["r+", "sI"])
+    centre = ((o * 4 + 0) * 7 + 3) * 7 + 3
+    assert big[0, o, 0].tolist() == [centre + 7 * 7, ((0 * 4 + 0) * 7 + 3) * 7 + 3]  # heading + 1; state I
+    assert (big[1, o] == -1).all()  # B1 of the O at (0, 0) is at (0, -1) at every heading but one
+    assert (big[1] == -1).all()  # no shape turns or changes shape in the corner
+
+
+def test_transitions_at_ignores_moving_obstacles():
+    occ = np.zeros((8, 8), dtype=bool)
+    moving = (MovingObstacle(np.array([[4, 2], [4, 3]]), np.array([[0, 0], [0, 4]])),)
+    ws = Workspace(occ, moving=moving)
+    cells = np.argwhere(np.ones((8, 8), dtype=bool))[:, ::-1]
+    assert np.array_equal(transitions_at(ws, cells), transitions_at(ws.without_moving(), cells))
+
+
+def test_transitions_at_memory_grows_with_the_cells_not_the_map():
+    """The same 100 cells take the same memory on a 150 x 150 and a 2000 x 2000 map (4 MB of occupancy):
+    no copy of the map, no table over it."""
+    cells = np.column_stack([np.arange(100), np.arange(100) * 7 % 150])
+
+    def peak_on(side):
+        ws = Workspace(np.zeros((side, side), dtype=bool))
+        transitions_at(ws, cells[:1])  # sweep tables cached
+        tracemalloc.start()
+        try:
+            rows = transitions_at(ws, cells)
+            return tracemalloc.get_traced_memory()[1], rows, ws
+        finally:
+            tracemalloc.stop()
+
+    small, _, _ = peak_on(150)
+    big, rows, ws = peak_on(2000)
+    assert rows.shape == (100, 7, 4, 13) and (rows >= 0).any()
+    assert rows.nbytes < big <= small + 2**14 and big < ws.occupancy.nbytes / 2
+
+
+def test_transitions_at_empty_cells():
+    ws = Workspace(np.zeros((5, 5), dtype=bool))
+    assert transitions_at(ws, []).shape == (0, 7, 4, 13)
+    assert transitions_at(ws, np.empty((0, 2), dtype=int), diagonals=True).shape == (0, 7, 4, 17)
+
+
+@pytest.mark.parametrize(
+    ("cells", "message"),
+    [
+        ([(5, 0)], r"inside the 5 x 4 map; outside it: cell \(5, 0\) \(the first at cells\[0\]\)"),
+        ([(0, 0), (-1, 2), (0, 4)], r"outside it: 2 cells \(-1, 2\), \(0, 4\) \(the first at cells\[1\]\)"),
+        (np.array([[0, 0], [2**63 + 5, 1]], dtype=np.uint64), r"outside it: cell \(9223372036854775813, 1\)"),
+        ([1, 2], r"an \(n, 2\) array of \(x, y\) cells \(one cell is \[\(x, y\)\]\), got shape \(2,\)"),
+        ([(0, 0, 0)], r"an \(n, 2\) array of \(x, y\) cells, got shape \(1, 3\)"),
+        (np.zeros((2, 2, 2), dtype=int), r"got shape \(2, 2, 2\)"),
+        ("ab", r"got shape \(\)"),
+        (None, r"got shape \(\)"),
+        ([(0, 0), (1,)], r"an \(n, 2\) array of \(x, y\) cells, got \[\(0, 0\), \(1,\)\]"),
+        ([(0.0, 1.0)], "must hold integer .* got an array of float64"),
+        ([(0.5, 1)], "must hold integer .* got an array of float64"),
+        ([(True, False)], "must hold integer .* got an array of bool"),
+    ],
+)
+def test_transitions_at_refuses_bad_cells(cells, message):
+    with pytest.raises(ParameterError, match=message):
+        transitions_at(Workspace(np.zeros((4, 5), dtype=bool)), cells)
+
+
+def test_transitions_at_refuses_bad_options():
+    ws = Workspace(np.zeros((4, 4), dtype=bool))
+    with pytest.raises(ParameterError, match="workspace must be a Workspace"):
+        transitions_at(np.zeros((4, 4), dtype=bool), [(1, 1)])
+    with pytest.raises(ParameterError, match="clearance"):
+        transitions_at(ws, [(1, 1)], clearance=-0.1)
+    with pytest.raises(ParameterError, match="diagonals"):
+        transitions_at(ws, [(1, 1)], diagonals=1)
+    with pytest.raises(UnknownCommandError, match="jump"):
+        transitions_at(ws, [(1, 1)], commands=["x+", "jump"])

@@ -13,6 +13,7 @@ SEED_000 = ["random", "h_shape", "spiral", "three_slit", "perpendicular_dynamic"
 SIZES = {
     **{name: (24, 24) for name in SEED_000},
     "zigzag": (24, 24), "maze": (24, 24), "maze_partial": (24, 24), "indoor_room": (128, 128),
+    "indoor_room_doorway": (128, 128),
     "tiling_6x6": (6, 6), "tiling_8x7": (8, 7), "tiling_10x10": (10, 10), "tiling_11x11": (11, 11),
     "coverage_16x7": (16, 7), "coverage_16x16": (16, 16),
 }
@@ -85,7 +86,8 @@ def test_only_the_tiling_maps_have_no_roadmap(scenarios):
 @pytest.mark.parametrize("name", sorted(set(SIZES) - WITHOUT_ROADMAP))
 def test_every_roadmap_is_solvable_and_the_plan_revalidates(scenarios, name):
     sc = scenarios[name]
-    diagonals = name in ("zigzag", "maze", "maze_partial", "indoor_room")  # seed 001 moves diagonally
+    diagonals = name in ("zigzag", "maze", "maze_partial", "indoor_room",
+                         "indoor_room_doorway")  # seed 001 moves diagonally
     plan = plan_exact(sc.workspace, sc.roadmap, diagonals=diagonals)
     assert plan.reached
     result = Simulator(sc.workspace, diagonals=diagonals).run([plan.commands], sc.start, roadmap=sc.roadmap[1:])

@@ -8,7 +8,8 @@
 
 - ``"heat"`` (:func:`plan_heat`): Do et al. 2021's heat-conduction planner, a search that climbs
   each leg's temperature field (:func:`solve_heat_field`, scikit-fem's bilinear element or
-  cell-centred), static maps only.
+  cell-centred), static maps only; :func:`replan_heat` runs it online on a scenario with hidden
+  obstacles (§VI-A-7), sensing and replanning as the robot moves, and returns a :class:`HeatRun`.
 
 Every method returns a :class:`Plan`, re-validated in the simulator.
 """
@@ -21,5 +22,6 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "plan_exact": "._exact", "EXACT_METHODS": "._exact",
     "plan_ga": "._ga",
     "plan_heat": "._heat",
+    "replan_heat": "._replan", "HeatRun": "._replan",
     "solve_heat_field": "._heat_field", "HeatField": "._heat_field",
 })

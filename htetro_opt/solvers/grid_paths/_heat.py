@@ -2,27 +2,42 @@
 
 Each leg solves the steady heat field of :func:`~htetro_opt.solvers.grid_paths.solve_heat_field` with the
 leg's goal B2 cell as source (T = 1) and its start B2 cell as sink (T = 0). The paper's reaching
-process (Table 4, step V) extends the reached set to the "equal or higher temperature" neighbours of
-each cell; here the search state is the whole pose (x, y, shape, heading), and the rule applies to
-the robot's B2 cell: a translation (diagonals included) from pose U to pose V is allowed iff
-``T(B2 of V) ≥ T(B2 of U) − ε`` (ε the field's tolerance); rotations and shapeshifts, which stay on
-B2's cell, always are. The graph is the exact planner's (the simulator's transition table) with that
-mask, searched by scipy's Dijkstra to convergence, so a leg's plan is optimal under the constraint
-[ours: the paper keeps the best of the reaching paths it enumerates].
+process (Table 4, steps 1–5) extends the reached set, wave by wave, to the "equal or higher
+temperature" neighbours of each cell; here the search state is the whole pose (x, y, shape, heading),
+and the rule applies to the robot's B2 cell: a translation (diagonals included) from pose U to pose V
+is allowed iff ``T(B2 of V) ≥ T(B2 of U) − ε`` (ε the field's tolerance, so that isothermal dead-end
+pockets stay enterable); rotations and shapeshifts, which stay on B2's cell, always are. The graph is
+the exact planner's (the simulator's transition table) with that mask. Stopping at the first wave
+that holds the goal would give the path of fewest waves; the search runs to convergence instead, so a
+leg's plan is optimal under the constraint [ours: the paper keeps the best of the reaching paths it
+enumerates]. ``engine="dijkstra"`` (scipy's csgraph) and ``engine="wavefront"`` (the waves themselves,
+relaxed until nothing improves; for small maps and tests) give the same optimum.
 
 Edge cost, minimised (eq. 12 as a sum over commands) [ours]::
 
-    J_i = [w_t t_i / t_max + w_sf s(pose after i) / L] / (w_t + w_sm + w_sf) + 1e-9 t_i / t_max
+    J_i = [w_t t_i / t_max + w_sm d_i / L + w_sf s(pose after i) / L] / (w_t + w_sm + w_sf) + 1e-9 t_i / t_max
 
-with ``s`` Fig. 5's safety penalty of a pose (:func:`~htetro_opt.problems.heat_costs.safety_pattern`)
-and ``L`` the number of commands of the leg's time-only constrained plan (the paper's ``1/l_p`` with
-the length fixed, so the cost stays a sum over edges); the last term breaks ties towards the faster
-plan. Minimising Σ s / L is not minimising the mean safety penalty of eq. 11 exactly (a plan with
-fewer commands divides by less). Smoothness (w_sm > 0) would need the last command in the search
-state and is not available yet.
+with ``s`` Fig. 5's safety penalty of a pose (:func:`~htetro_opt.problems.heat_costs.safety_pattern`),
+``d_i`` = 1 when command i differs from command i − 1 (eq. 10; the first command is free), and ``L``
+the number of commands of the leg's time-only constrained plan (the paper's ``1/l_p`` with the length
+fixed, so the cost stays a sum over edges); the last term breaks ties towards the faster plan.
+Minimising Σ s / L is not minimising eq. 11's mean exactly (a plan with fewer commands divides by
+less); the plan's ``info["fitness"]`` reports the exact eqs. 9–12. With w_sm > 0 the last command
+becomes part of the search state: one layer of poses per repeatable command (translations and
+rotations; a shapeshift cannot repeat) and a hub layer, entered at no cost from every layer, whose
+commands pay the change ``w_sm / L`` — a repeat inside a layer does not.
 
 When no monotone path exists but an unconstrained one does, the leg takes the unconstrained optimum
 and ``info["relaxed"]`` says so; ``monotone=False`` searches unconstrained throughout.
+
+**Band** [ours, for large maps]. The whole pose graph of a 1000 x 1000 map has 28 million poses;
+``band`` restricts a leg's search to the poses whose B2 cell lies within Chebyshev distance r of the
+field's steepest-ascent line from the start's cell to the goal's (over the grid nodes for ``"q1"``,
+over the cells without cutting an obstacle corner for ``"p0"``; by the discrete maximum principle the
+line never stalls, and on a numerical stall the band follows the ``grid_distance`` shortest path
+instead). No path in the band doubles r, until the band holds every free cell, where the band search
+is the full search (relaxed if no monotone path exists). Transitions are computed for the band's cells
+only (:func:`~htetro_opt.model.simulate.transitions_at`), and the plan is replayed through them.
 """
 
 from __future__ import annotations
@@ -31,26 +46,46 @@ import reprlib
 import time as _time
 from collections.abc import Mapping
 from dataclasses import replace
+from types import SimpleNamespace
 from typing import Sequence
 
 import numpy as np
+from scipy.ndimage import maximum_filter
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
 
-from htetro_opt._validation import check_bool, check_real
-from htetro_opt.errors import ParameterError
+from htetro_opt._validation import check_bool, check_int, check_real
+from htetro_opt.errors import ConfigurationError, ParameterError, PlanningError
 from htetro_opt.model.commands import COMMANDS, Timing, command_set
 from htetro_opt.model.robot import N_HEADINGS, Pose
-from htetro_opt.model.simulate import Simulator
-from htetro_opt.model.workspace import Workspace
+from htetro_opt.model.commands import command_id
+from htetro_opt.model.robot import as_pose, shape_index
+from htetro_opt.model.simulate import Simulator, check_memory, table_shape, transitions_at
+from htetro_opt.model.sweeps import sweep_tables
+from htetro_opt.model.workspace import Workspace, describe_cells, grid_distance
 from htetro_opt.problems.heat_costs import default_t_max, heat_fitness, safety_pattern
-from htetro_opt.solvers.grid_paths._exact import _check_memory, _dijkstra_leg, _Graph
+from htetro_opt.solvers.grid_paths._exact import _GRAPH_BYTES, _check_memory, _Graph
 from htetro_opt.solvers.grid_paths._heat_field import HEAT_ELEMENTS, solve_heat_field
 from htetro_opt.solvers.grid_paths._result import Plan, check_map, check_roadmap, finish_plan, prepare
 
-__all__ = ["plan_heat"]
+__all__ = ["plan_heat", "HEAT_ENGINES", "BAND_SEEDS", "BAND_AUTO_POSES", "BAND_AUTO_RADIUS"]
+
+HEAT_ENGINES = ("dijkstra", "wavefront")
+"""Searches of a leg: scipy's Dijkstra, or the paper's waves relaxed to convergence (same optimum)."""
+
+BAND_SEEDS = ("ascent", "grid_distance")
+"""Lines a band follows: the field's steepest-ascent line, or a shortest cell path (an ablation)."""
+
+BAND_AUTO_POSES = 4_000_000
+"""``band="auto"`` searches the whole pose graph up to this many poses, and a band above."""
+
+BAND_AUTO_RADIUS = 8
+"""``band="auto"``'s first band radius (cells, Chebyshev) on maps above :data:`BAND_AUTO_POSES`."""
 
 _FIELD_OPTIONS = ("k_obstacle", "split_pinches", "solver", "tol")
 _TIE_BREAK = 1e-9
 _MOVES = ("translation", "diagonal")
+_TABLE_BYTES = 8 + 1 + 8  # per (pose, command) of a band: targets (int64), usable mask, weights
 
 
 def _check_weights(weights) -> tuple[float, float, float]:
@@ -60,10 +95,15 @@ def _check_weights(weights) -> tuple[float, float, float]:
               for i, (v, name) in enumerate(zip(weights, ("w_t", "w_sm", "w_sf"))))
     if sum(w) <= 0:
         raise ParameterError(f"weights (w_t, w_sm, w_sf) must not all be zero, got {list(w)}")
-    if w[1] > 0:
-        raise ParameterError(f"weights[1] (w_sm) = {w[1]:g}: the heat planner's smoothness cost needs the last "
-                             "command in the search state, which is not available yet; use w_sm = 0")
     return w
+
+
+def _check_band(band) -> str | int:
+    if isinstance(band, str):
+        if band in ("auto", "full"):
+            return band
+        raise ParameterError(f"unknown band {band!r}: expected 'auto', 'full' or a radius in cells (an integer ≥ 1)")
+    return check_int(band, "band (radius in cells)", minimum=1)
 
 
 def _check_field_options(options) -> dict:
@@ -98,23 +138,248 @@ def _command_ids(workspace, commands) -> tuple[int, ...]:
     return ids
 
 
-def _safety_penalties(sim: Simulator) -> np.ndarray:
-    """Fig. 5's penalty s of every pose id (and 0 for the dead pose): Σ n_c W_obs(c) / |U|, off-map cells
-    counting as obstacles, as :func:`~htetro_opt.problems.heat_costs.heat_fitness` scores them."""
-    ws = sim.workspace
-    h, w = ws.height, ws.width
-    patterns = [[safety_pattern(s, k) for k in range(N_HEADINGS)] for s in range(sim.n_states)]
+def _safety_at(ws: Workspace, cells: np.ndarray, n_states: int) -> np.ndarray:
+    """Fig. 5's penalty s of the poses at flat cells ``cells`` (y * W + x), shape (len(cells), states, 4):
+    Σ n_c W_obs(c) / |U|, off-map cells counting as obstacles, as
+    :func:`~htetro_opt.problems.heat_costs.heat_fitness` scores them."""
+    patterns = [[safety_pattern(s, k) for k in range(N_HEADINGS)] for s in range(n_states)]
     pad = max(int(np.abs(offsets).max()) for row in patterns for offsets, _ in row)
     blocked = np.pad(np.asarray(ws.occupancy, dtype=np.float64), pad, constant_values=1.0)
-    s = np.zeros(sim.n_poses + 1)
+    y, x = np.divmod(cells, ws.width)
+    s = np.empty((len(cells), n_states, N_HEADINGS))
     for state, row in enumerate(patterns):
         for heading, (offsets, weights) in enumerate(row):
-            total = np.zeros((h, w))
-            for (dx, dy), n_c in zip(offsets.tolist(), weights.tolist()):
-                total += n_c * blocked[pad + dy: pad + dy + h, pad + dx: pad + dx + w]
-            base = (state * N_HEADINGS + heading) * h * w
-            s[base: base + h * w] = (total / len(offsets)).ravel()
+            around = blocked[pad + y[:, None] + offsets[None, :, 1], pad + x[:, None] + offsets[None, :, 0]]
+            s[:, state, heading] = around @ weights / len(offsets)
     return s
+
+
+class _Space:
+    """The poses one search sees, duck-typed as the simulator :class:`_Graph` reads: the whole
+    simulator, or a band of cells with its transitions (pose id = (band cell * states + state) * 4 +
+    heading, the band's cells in map order)."""
+
+    def __init__(self, sim, cell_of: np.ndarray, safety: np.ndarray | None, cells: np.ndarray | None = None):
+        self.sim = sim
+        self.cell_of = cell_of  # flat map cell (y * W + x) of every pose
+        self.safety = safety  # s of every pose, or None
+        self.cells = cells  # a band's flat cells, sorted; None for the whole simulator
+
+    @classmethod
+    def whole(cls, sim: Simulator, with_safety: bool) -> "_Space":
+        ws = sim.workspace
+        cells = ws.width * ws.height
+        safety = None
+        if with_safety:  # simulator ids are state-major: ((state * 4 + heading) * H + y) * W + x
+            safety = _safety_at(ws, np.arange(cells), sim.n_states).transpose(1, 2, 0).ravel()
+        return cls(sim, np.arange(sim.n_poses) % cells, safety)
+
+    @classmethod
+    def band(cls, ws: Workspace, cells: np.ndarray, *, ids, n_states: int, tables, durations,
+             with_safety: bool) -> "_Space":
+        per_cell = n_states * N_HEADINGS
+        n, hw = len(cells) * per_cell, ws.width * ws.height
+        check_memory(n * len(ids) * (_TABLE_BYTES + _GRAPH_BYTES), f"the heat planner's search band of {len(cells)} "
+                     f"cells on this {ws.width} x {ws.height} map", "give a smaller band radius, or a smaller map")
+        xy = np.column_stack([cells % ws.width, cells // ws.width])
+        target = transitions_at(ws, xy, commands=list(ids), clearance=tables.clearance).reshape(n, len(ids))
+        local_of_cell = np.full(hw, -1, dtype=np.int64)
+        local_of_cell[cells] = np.arange(len(cells))
+        valid = target >= 0
+        g = np.where(valid, target, 0)
+        band_cell = local_of_cell[g % hw]
+        local = band_cell * per_cell + g // hw
+        local[~valid | (band_cell < 0)] = n  # dead, or out of the band
+        sim = SimpleNamespace(workspace=ws, tables=tables, command_ids=np.asarray(ids, dtype=np.int64),
+                              n_commands=len(ids), n_states=n_states, n_poses=n, dead=n, next=local,
+                              durations=np.append(durations, 0.0))
+        safety = _safety_at(ws, cells, n_states).ravel() if with_safety else None
+        return cls(sim, np.repeat(cells, per_cell), safety, cells)
+
+    def pose_id(self, row) -> int:
+        """Id of an (x, y, state, heading) row in this space (-1 if its cell is not in the band)."""
+        x, y, s, h = (int(v) for v in row)
+        ws = self.sim.workspace
+        if self.cells is None:
+            return ((s * N_HEADINGS + h) * ws.height + y) * ws.width + x
+        i = int(np.searchsorted(self.cells, y * ws.width + x))
+        if i == len(self.cells) or self.cells[i] != y * ws.width + x:
+            return -1
+        return (i * self.sim.n_states + s) * N_HEADINGS + h
+
+    def rows(self, start: int, steps: list[int]) -> np.ndarray:
+        """(x, y, state, heading) of the poses after each local command from pose ``start``."""
+        nodes = [start]
+        for c in steps:
+            nodes.append(int(self.sim.next[nodes[-1], c]))
+        nodes = np.array(nodes[1:], dtype=np.int64)
+        per_cell = self.sim.n_states * N_HEADINGS
+        flat, sh = self.cell_of[nodes], nodes % per_cell
+        ws = self.sim.workspace
+        return np.stack([flat % ws.width, flat // ws.width, sh // N_HEADINGS, sh % N_HEADINGS], axis=-1)
+
+
+def _wavefront(matrix, source: int) -> tuple[np.ndarray, np.ndarray]:
+    """Do et al. 2021's reaching waves (Table 4, steps 1–5) relaxed to convergence: every pose reached
+    or improved in one wave extends the next; same distances as Dijkstra (a label-correcting search)."""
+    n = matrix.shape[0]
+    dist = np.full(n, np.inf)
+    pred = np.full(n, -9999, dtype=np.int64)
+    dist[source] = 0.0
+    wave = np.array([source])
+    indptr, indices, data = matrix.indptr, matrix.indices, matrix.data
+    while len(wave):
+        counts = indptr[wave + 1] - indptr[wave]
+        first = np.repeat(indptr[wave] - np.cumsum(counts) + counts, counts)
+        edges = first + np.arange(counts.sum())
+        u, v = np.repeat(wave, counts), indices[edges]
+        reach = dist[u] + data[edges]
+        better = reach < dist[v]
+        u, v, reach = u[better], v[better], reach[better]
+        order = np.lexsort((reach, v))
+        keep = order[np.r_[True, v[order][1:] != v[order][:-1]]] if len(order) else order
+        dist[v[keep]], pred[v[keep]] = reach[keep], u[keep]
+        wave = v[keep]
+    return dist, pred
+
+
+class _LegSearch:
+    """One leg's weighted search over a space, optionally with the last command in the state."""
+
+    def __init__(self, space: _Space, mask, cost: np.ndarray, change: float, engine: str):
+        self.space, self.engine = space, engine
+        self.graph = _Graph(space.sim, mask=mask, weights=cost)
+        self.change = change
+        sim = space.sim
+        kinds = [COMMANDS[int(g)].kind for g in sim.command_ids]
+        self.repeatable = np.array([k != "shapeshift" for k in kinds])
+        self.layers = 1 + int(self.repeatable.sum()) if change > 0 else 1
+        self.layer_of = np.zeros(sim.n_commands, dtype=np.int64)
+        self.layer_of[self.repeatable] = np.arange(1, self.repeatable.sum() + 1)
+
+    def _matrix(self):
+        g = self.graph
+        if self.layers == 1:
+            return g.matrix()
+        n = g.sim.n_poses
+        u, c = np.nonzero(g.usable)
+        v = g.target[u, c].astype(np.int64)
+        w = g.weights[u, c]
+        layer = self.layer_of[c]
+        repeat = layer > 0
+        rows = [u, layer[repeat] * n + u[repeat], np.arange(n, n * self.layers)]
+        cols = [layer * n + v, layer[repeat] * n + v[repeat], np.tile(np.arange(n), self.layers - 1)]
+        data = [w + self.change, w[repeat], np.zeros(n * (self.layers - 1))]
+        return coo_matrix((np.concatenate(data), (np.concatenate(rows), np.concatenate(cols))),
+                          shape=(n * self.layers, n * self.layers)).tocsr()
+
+    def run(self, start: int, goal: int) -> tuple[list[int], float] | None:
+        """Local commands of the optimum start → goal and its cost J, or None."""
+        matrix = self._matrix()
+        if self.engine == "dijkstra":
+            dist, pred = dijkstra(matrix, indices=start, return_predecessors=True)
+        else:
+            dist, pred = _wavefront(matrix, start)
+        n = self.graph.sim.n_poses
+        ends = goal + n * np.arange(self.layers)
+        end = int(ends[np.argmin(dist[ends])])
+        if not np.isfinite(dist[end]):
+            return None
+        nodes = [end]
+        while nodes[-1] != start:
+            nodes.append(int(pred[nodes[-1]]))
+        nodes.reverse()
+        steps = []
+        for a, b in zip(nodes[:-1], nodes[1:]):
+            (la, pa), (lb, pb) = divmod(a, n), divmod(b, n)
+            if la > 0 and lb == 0:  # into the hub: no command
+                continue
+            steps.append(int(np.flatnonzero(self.layer_of == la)[0]) if la > 0
+                         else self.graph.step_command(pa, pb, 0))
+        return steps, float(dist[end])
+
+
+def _ascent_line(field, start: tuple[int, int], goal: tuple[int, int], free: np.ndarray) -> np.ndarray | None:
+    """Cells along the field's steepest-ascent line from the start's cell to the goal's: over the grid
+    nodes (q1), or over the cells without cutting an obstacle corner (p0). None on a stall (a
+    plateau the tolerance cannot order)."""
+    h, w = free.shape
+    if field.corners is not None:
+        # A node's value: the largest of its elements' values (split pinch nodes have one per cell).
+        values = np.full((h + 1, w + 1), -np.inf)
+        for j in (0, 1):
+            for i in (0, 1):
+                c = np.where(np.isnan(field.corners[:, :, j, i]), -np.inf, field.corners[:, :, j, i])
+                values[j: j + h, i: i + w] = np.maximum(values[j: j + h, i: i + w], c)
+        gx, gy = goal
+        node = min(((start[0] + i, start[1] + j) for j in (0, 1) for i in (0, 1)), key=lambda p: values[p[1], p[0]])
+        path = [node]
+        goal_nodes = {(gx + i, gy + j) for j in (0, 1) for i in (0, 1)}
+        while path[-1] not in goal_nodes:
+            x, y = path[-1]
+            best, best_value = None, values[y, x]
+            for dx in (-1, 0, 1):
+                for dy in (-1, 0, 1):
+                    nx, ny = x + dx, y + dy
+                    if (dx, dy) == (0, 0) or not (0 <= nx <= w and 0 <= ny <= h):
+                        continue
+                    # the move runs inside a conducting cell: the diagonal's cell, or one beside the edge
+                    cells = ([(min(x, nx), min(y, ny))] if dx and dy else
+                             [(min(x, nx), y - 1), (min(x, nx), y)] if dx else [(x - 1, min(y, ny)), (x, min(y, ny))])
+                    if not any(0 <= cx < w and 0 <= cy < h and np.isfinite(field.cells[cy, cx]) for cx, cy in cells):
+                        continue
+                    if values[ny, nx] > best_value:
+                        best, best_value = (nx, ny), values[ny, nx]
+            if best is None:
+                return None
+            path.append(best)
+        nodes = np.array(path)
+        line = np.zeros((h, w), dtype=bool)
+        for j in (0, 1):
+            for i in (0, 1):
+                cx, cy = nodes[:, 0] - i, nodes[:, 1] - j
+                inside = (cx >= 0) & (cx < w) & (cy >= 0) & (cy < h)
+                line[cy[inside], cx[inside]] = True
+        return line & free
+    t = np.where(np.isnan(field.cells), -np.inf, field.cells)
+    path = [tuple(start)]
+    while path[-1] != tuple(goal):
+        x, y = path[-1]
+        best, best_value = None, t[y, x]
+        for dx in (-1, 0, 1):
+            for dy in (-1, 0, 1):
+                nx, ny = x + dx, y + dy
+                if (dx, dy) == (0, 0) or not (0 <= nx < w and 0 <= ny < h) or not free[ny, nx]:
+                    continue
+                if dx and dy and not (free[y, nx] and free[ny, x]):
+                    continue
+                if t[ny, nx] > best_value:
+                    best, best_value = (nx, ny), t[ny, nx]
+        if best is None:
+            return None
+        path.append(best)
+    line = np.zeros((h, w), dtype=bool)
+    xy = np.array(path)
+    line[xy[:, 1], xy[:, 0]] = True
+    return line
+
+
+def _distance_line(ws: Workspace, start: tuple[int, int], goal: tuple[int, int]) -> np.ndarray | None:
+    """Cells of a shortest 8-connected cell path start → goal (``grid_distance``), None if none."""
+    distance = grid_distance(ws, goal, diagonals=True)
+    if not np.isfinite(distance[start[1], start[0]]):
+        return None
+    h, w = distance.shape
+    padded = np.pad(distance, 1, constant_values=np.inf)
+    line = np.zeros((h, w), dtype=bool)
+    x, y = start
+    line[y, x] = True
+    while (x, y) != tuple(goal):
+        around = padded[y: y + 3, x: x + 3]
+        dy, dx = np.unravel_index(np.argmin(around), (3, 3))
+        x, y = x + int(dx) - 1, y + int(dy) - 1
+        line[y, x] = True
+    return line
 
 
 def plan_heat(
@@ -125,10 +390,14 @@ def plan_heat(
     t_max: float | None = None,
     element: str = "q1",
     monotone: bool = True,
+    band: str | int = "auto",
+    band_seed: str = "ascent",
+    engine: str = "dijkstra",
     commands: Sequence[str] | None = None,
     timing: Timing | None = None,
     clearance: float = 0.0,
     field_options: Mapping | None = None,
+    keep_fields: bool = False,
 ) -> Plan:
     """Do et al. 2021's heat-conduction plan through a roadmap: climb each leg's temperature field.
 
@@ -136,11 +405,11 @@ def plan_heat(
     ----------
     workspace : Workspace or Simulator
         A static map, or an already compiled simulator (then ``commands``, ``timing`` and
-        ``clearance`` are its own).
+        ``clearance`` are its own, and the whole graph is searched).
     roadmap : sequence of Pose
         Start first, goal last, at least two configurations.
     weights : sequence of 3 float, keyword-only
-        (w_t, w_sm, w_sf) of eq. 12: finite, ≥ 0, not all zero; w_sm must be 0 (not available yet).
+        (w_t, w_sm, w_sf) of eq. 12: finite, ≥ 0, not all zero.
     t_max : float, optional, keyword-only
         Eq. 9's time budget (default :func:`~htetro_opt.problems.heat_costs.default_t_max`).
     element : {"q1", "p0"}, keyword-only
@@ -148,6 +417,15 @@ def plan_heat(
     monotone : bool, keyword-only
         Allow only translations to equal or higher temperature (the paper's rule); False searches
         without the field (the same costs, unconstrained).
+    band : "auto", "full" or int, keyword-only
+        Search the whole pose graph (``"full"``), or a band of that Chebyshev radius (cells) around
+        the field's ascent line, doubled until a path is found; ``"auto"``: full up to
+        :data:`BAND_AUTO_POSES` poses, else radius :data:`BAND_AUTO_RADIUS`.
+    band_seed : {"ascent", "grid_distance"}, keyword-only
+        The line a band follows: the field's steepest ascent (the paper's guidance), or a shortest
+        8-connected cell path that ignores the field (an ablation: what the field buys).
+    engine : {"dijkstra", "wavefront"}, keyword-only
+        scipy's Dijkstra, or the paper's reaching waves relaxed to convergence (slower; same optimum).
     commands : sequence of str, optional, keyword-only
         Command tokens (default: Do et al. 2021's 17, Cheng et al. 2020's set plus the diagonals).
     timing : Timing, optional, keyword-only
@@ -155,21 +433,26 @@ def plan_heat(
         δ in cells (MODEL.md §4).
     field_options : mapping, optional, keyword-only
         More options of ``solve_heat_field``: ``k_obstacle``, ``split_pinches``, ``solver``, ``tol``.
+    keep_fields : bool, keyword-only
+        Also keep each leg's :class:`~htetro_opt.solvers.grid_paths.HeatField` in ``info["fields"]``
+        (for plots; not JSON).
 
     Returns
     -------
     Plan
         Method ``"heat"``; ``reached`` is False (not an exception) when a leg has no path at all.
-        ``info``: ``weights``, ``t_max``, ``relaxed`` (per solved leg: no monotone path, the
-        unconstrained one taken), ``field`` (per leg: ``element``, ``dofs``, ``solver``,
-        ``seconds``) and ``fitness`` (:func:`~htetro_opt.problems.heat_costs.heat_fitness` of the
-        whole plan: ``f_t``, ``f_sm``, ``f_sf``, ``f``).
+        ``info`` (JSON-ready but for ``fields``): ``weights``, ``t_max``, and per solved leg
+        ``relaxed`` (no monotone path: the unconstrained one taken), ``surrogate`` (the J minimised),
+        ``band`` (``radius`` (None = whole graph), ``cells``, ``seed``: ``"ascent"``,
+        ``"grid_distance"`` or None); per leg ``field`` (``element``, ``dofs``, ``solver``,
+        ``iterations``, ``seconds``); ``fitness`` (:func:`~htetro_opt.problems.heat_costs.heat_fitness`
+        of the whole plan: ``f_t``, ``f_sm``, ``f_sf``, ``f``).
 
     Raises
     ------
     ParameterError
-        On bad weights, t_max, element, field options or commands (Cheng et al. 2019's block
-        commands are refused), or a map with moving obstacles (static maps only).
+        On bad weights, t_max, element, band, engine, field options or commands (Cheng et al. 2019's
+        block commands are refused), or a map with moving obstacles (static maps only).
     PlanningError
         If the roadmap has fewer than two configurations, or the tables would not fit in memory.
     ConfigurationError
@@ -184,73 +467,205 @@ def plan_heat(
     """
     w = _check_weights(weights)
     monotone = check_bool(monotone, "monotone")
+    keep_fields = check_bool(keep_fields, "keep_fields")
+    band = _check_band(band)
+    if not isinstance(band_seed, str) or band_seed not in BAND_SEEDS:
+        raise ParameterError(f"unknown band_seed {band_seed!r}: expected one of {', '.join(BAND_SEEDS)}")
     if not isinstance(element, str) or element not in HEAT_ELEMENTS:
         raise ParameterError(f"unknown element {element!r}: expected one of {', '.join(HEAT_ELEMENTS)}")
+    if not isinstance(engine, str) or engine not in HEAT_ENGINES:
+        raise ParameterError(f"unknown engine {engine!r}: expected one of {', '.join(HEAT_ENGINES)}")
     options = _check_field_options(field_options)
     check_map(workspace)
     roadmap = check_roadmap(roadmap)
-    ws = workspace.workspace if isinstance(workspace, Simulator) else workspace
+    compiled = isinstance(workspace, Simulator)
+    ws = workspace.workspace if compiled else workspace
     if ws.moving:
         raise ParameterError("the heat planner plans on static maps only: use dijkstra with moving obstacles")
     ids_set = _command_ids(workspace, commands)
-    if not isinstance(workspace, Simulator) and timing is not None and not isinstance(timing, Timing):
+    if not compiled and timing is not None and not isinstance(timing, Timing):
         raise ParameterError(f"timing must be a Timing or None, got {type(timing).__name__} {reprlib.repr(timing)}")
-    t_max = (default_t_max(ws, workspace.timing if isinstance(workspace, Simulator) else timing) if t_max is None
+    timing = workspace.timing if compiled else (timing or Timing())
+    t_max = (default_t_max(ws, timing) if t_max is None
              else check_real(t_max, "t_max", minimum=0.0, include_minimum=False))
-    _check_memory(workspace, "dijkstra", list(ids_set), False)
+    n_poses, _ = table_shape(ws, commands=list(ids_set))
+    whole = compiled or band == "full" or (band == "auto" and n_poses <= BAND_AUTO_POSES)
+    radius = None if whole else (BAND_AUTO_RADIUS if band == "auto" else band)
     began = _time.perf_counter()
-    sim, roadmap, ids = prepare(workspace, roadmap, commands=list(ids_set), timing=timing, clearance=clearance)
+    if whole:
+        if not compiled:
+            _check_memory(workspace, "dijkstra", list(ids_set), False)
+        sim, roadmap, ids = prepare(workspace, roadmap, commands=list(ids_set), timing=timing, clearance=clearance)
+        space = _Space.whole(sim, w[2] > 0)
+        rows = [sim.decode(i) for i in ids]
+    else:
+        tables = sweep_tables(check_real(clearance, "clearance", minimum=0.0))
+        n_states = n_poses // (N_HEADINGS * ws.width * ws.height)
+        rows = [_pose_row(ws, pose, _pose_name(i, len(roadmap)), n_states, tables) for i, pose in enumerate(roadmap)]
+        band_options = dict(ids=ids_set, n_states=n_states, tables=tables, with_safety=w[2] > 0,
+                            durations=timing.durations()[list(ids_set)])
 
-    n, c, cells = sim.n_poses, sim.n_commands, ws.width * ws.height
-    target = sim.next[:n, :c]
-    moves = np.array([COMMANDS[int(g)].kind in _MOVES for g in sim.command_ids])
-    time_cost = np.broadcast_to(sim.durations[:c] / t_max, (n, c))
-    tie = _TIE_BREAK * time_cost
-    safety = _safety_penalties(sim)[target] if w[2] > 0 else None  # s of the pose each edge leads to
-
-    def leg_plan(a: int, b: int, mask) -> list[int] | None:
-        """The leg's optimum under ``mask``: time first, then (with w_sf) J with L from the time plan."""
-        timed = _dijkstra_leg(_Graph(sim, mask=mask, weights=time_cost + tie), a, b, 0)
-        if timed is None or safety is None:
+    def search(space: _Space, a: int, b: int, field) -> tuple[list[int], float] | None:
+        """The leg's optimum in ``space`` (local commands, J), under the field's rule if ``field``."""
+        sim = space.sim
+        n, c = sim.n_poses, sim.n_commands
+        target = sim.next[:n, :c]
+        time_cost = np.broadcast_to(sim.durations[:c] / t_max, (n, c))
+        tie = _TIE_BREAK * time_cost
+        mask = None
+        if field is not None:
+            moves = np.array([COMMANDS[int(g)].kind in _MOVES for g in sim.command_ids])
+            temperature = field.cells.ravel()
+            here = temperature[space.cell_of][:, None]
+            there = temperature[space.cell_of[np.minimum(target, n - 1)]]  # dead targets: masked by the graph
+            mask = ~moves[None, :] | (there >= here - field.epsilon)
+        timed = _LegSearch(space, mask, time_cost + tie, 0.0, engine).run(a, b)
+        if timed is None or (w[1] == 0 and w[2] == 0):
             return timed
-        cost = (w[0] * time_cost + w[2] * safety / max(len(timed), 1)) / sum(w) + tie
-        return _dijkstra_leg(_Graph(sim, mask=mask, weights=cost), a, b, 0)
+        length = max(len(timed[0]), 1)
+        cost = w[0] * time_cost / sum(w) + tie
+        if space.safety is not None:
+            cost = cost + w[2] * space.safety[np.minimum(target, n - 1)] / (length * sum(w))
+        return _LegSearch(space, mask, cost, w[1] / (length * sum(w)), engine).run(a, b)
 
-    local: list[int] = []
+    commands_out: list[int] = []
+    poses_out = [np.asarray(rows[0], dtype=np.int64)[None]]
     leg_ends: list[int] = []
     relaxed: list[bool] = []
-    fields: list[dict] = []
+    surrogate: list[float] = []
+    bands: list[dict] = []
+    records: list[dict] = []
+    fields = []
     failed = -1
-    for leg, (a, b) in enumerate(zip(ids[:-1], ids[1:])):
-        mask = None
-        record = {"element": element, "dofs": 0, "solver": None, "seconds": 0.0}
-        if monotone and a != b:
-            field = solve_heat_field(ws, tuple(int(v) for v in sim.decode(b)[:2]),
-                                     tuple(int(v) for v in sim.decode(a)[:2]), element=element, **options)
-            record.update(dofs=int(field.info.get("dofs", 0)), solver=field.info.get("solver"),
-                          seconds=float(field.info.get("seconds", 0.0)))
-            if field.connected:
-                temperature = field.cells.ravel()
-                here = temperature[np.arange(n) % cells][:, None]
-                there = temperature[target % cells]  # the dead pose's cell: masked by the graph anyway
-                mask = ~moves[None, :] | (there >= here - field.epsilon)
-        fields.append(record)
-        steps = [] if a == b else leg_plan(a, b, mask) if mask is not None else None
-        leg_relaxed = False
-        if steps is None:  # no monotone path (or no field): the unconstrained optimum, if any
-            steps = leg_plan(a, b, None)
-            leg_relaxed = monotone and steps is not None
-        if steps is None:
+    for leg in range(len(roadmap) - 1):
+        a_row, b_row = np.asarray(rows[leg]), np.asarray(rows[leg + 1])
+        record = {"element": element, "dofs": 0, "solver": None, "iterations": 0, "seconds": 0.0}
+        field = None
+        if (a_row != b_row).any() and monotone:
+            field = solve_heat_field(ws, (int(b_row[0]), int(b_row[1])), (int(a_row[0]), int(a_row[1])),
+                                     element=element, **options)
+            record.update({key: field.info.get(key) for key in record if key != "element"})
+            fields.append(field)
+        records.append(record)
+        rule = field if monotone and field is not None and field.connected else None
+        if (a_row == b_row).all():
+            found, leg_band = ([], 0.0, False, np.empty((0, 4), dtype=np.int64)), {"radius": radius, "cells": 0,
+                                                                                   "seed": None}
+        elif whole:
+            found = _relaxed(search, space, space.pose_id(a_row), space.pose_id(b_row), rule, monotone)
+            leg_band = {"radius": None, "cells": ws.width * ws.height, "seed": None}
+        else:
+            found, leg_band = _band_search(search, ws, a_row, b_row, field, rule, monotone, radius, band_seed,
+                                           band_options)
+        bands.append(leg_band)
+        if found is None:
             failed = leg
             break
+        steps, cost, leg_relaxed, leg_rows = found
         relaxed.append(leg_relaxed)
-        local.extend(steps)
-        leg_ends.append(len(local))
-
-    global_ids = sim.command_ids[np.array(local, dtype=np.int64)] if local else np.empty(0, dtype=np.int64)
-    info = {"weights": list(w), "t_max": float(t_max), "relaxed": relaxed, "field": fields}
-    plan = finish_plan(sim, global_ids, ids[0], method="heat", leg_ends=leg_ends, failed_leg=failed,
-                       began=began, info=info)
-    fitness = heat_fitness(sim.workspace, plan.poses, plan.commands, t_max=t_max, timing=sim.timing, weights=w)
+        surrogate.append(cost)
+        commands_out.extend(steps)
+        poses_out.append(leg_rows)
+        leg_ends.append(len(commands_out))
+    info = {"weights": list(w), "t_max": float(t_max), "relaxed": relaxed, "surrogate": surrogate,
+            "band": bands, "field": records}
+    if keep_fields:
+        info["fields"] = fields
+    global_ids = np.array(commands_out, dtype=np.int64)
+    if whole:
+        plan = finish_plan(sim, global_ids, ids[0], method="heat", leg_ends=leg_ends, failed_leg=failed,
+                           began=began, info=info)
+    else:
+        plan = _finish_band_plan(ws, global_ids, np.concatenate(poses_out), ids_set, tables, timing,
+                                 leg_ends=leg_ends, failed=failed, began=began, info=info)
+    fitness = heat_fitness(ws, plan.poses, plan.commands, t_max=t_max, timing=timing, weights=w)
     return replace(plan, info={**plan.info, "fitness": fitness})
 
+
+def _relaxed(search, space: _Space, a: int, b: int, rule, monotone: bool):
+    """The leg under the field's rule, else unconstrained (flagged relaxed when the rule was asked
+    for): global command ids, J, relaxed, poses after each command."""
+    found = search(space, a, b, rule) if rule is not None else None
+    leg_relaxed = False
+    if found is None:
+        found, leg_relaxed = search(space, a, b, None), monotone
+    if found is None:
+        return None
+    steps, cost = found
+    return [int(space.sim.command_ids[s]) for s in steps], cost, leg_relaxed, space.rows(a, steps)
+
+
+def _pose_name(i: int, n: int) -> str:
+    return "start" if i == 0 else "goal" if i == n - 1 else f"roadmap configuration {i + 1}"
+
+
+def _pose_row(ws: Workspace, pose, what: str, n_states: int, tables) -> np.ndarray:
+    """(x, y, state, heading) of a roadmap pose, checked as ``Simulator.check_pose`` checks it,
+    without the simulator's whole table."""
+    pose = as_pose(pose, what)
+    s = shape_index(pose.shape)
+    if s >= n_states:
+        raise ConfigurationError(f"{what} {tuple(pose)}: state {pose.shape!r} is an intermediate state, which the "
+                                 "heat planner's commands cannot reach")
+    if not ws.contains(pose.x, pose.y):
+        raise ConfigurationError(f"{what} {tuple(pose)}: pose ({pose.x}, {pose.y}) lies outside the "
+                                 f"{ws.width} x {ws.height} map")
+    footprint = tables.cells(s, pose.heading, command_id("stop")) + np.array([pose.x, pose.y])
+    inside = ((footprint >= 0) & (footprint < np.array([ws.width, ws.height]))).all(axis=1)
+    conflicts = [(int(x), int(y)) for (x, y), ok in zip(footprint, inside) if not ok or ws.occupancy[y, x]]
+    if conflicts:
+        margin = f" (with clearance {tables.clearance:g})" if tables.clearance else ""
+        raise ConfigurationError(f"{what} {tuple(pose)}{margin} collides with obstacles or the map edge at "
+                                 f"{describe_cells(conflicts)}")
+    return np.array([pose.x, pose.y, s, pose.heading], dtype=np.int64)
+
+
+def _band_search(search, ws: Workspace, a_row, b_row, field, rule, monotone: bool, radius: int, band_seed: str,
+                 options: dict):
+    """A leg searched in widening bands around the field's ascent line (or the grid_distance path)."""
+    free = ~ws.occupancy
+    a_cell, b_cell = (int(a_row[0]), int(a_row[1])), (int(b_row[0]), int(b_row[1]))
+    line, seed = None, None
+    if rule is not None and band_seed == "ascent":
+        line, seed = _ascent_line(field, a_cell, b_cell, free), "ascent"
+    if line is None:
+        line, seed = _distance_line(ws, a_cell, b_cell), "grid_distance"
+    if line is None:  # not even 8-connected: no robot passes
+        return None, {"radius": radius, "cells": 0, "seed": None}
+    r, n_free = radius, int(free.sum())
+    while True:
+        inside = maximum_filter(line, size=2 * r + 1, mode="constant", cval=False) & free
+        cells = np.flatnonzero(inside.ravel())
+        space = _Space.band(ws, cells, **options)
+        record = {"radius": r, "cells": len(cells), "seed": seed}
+        a, b = space.pose_id(a_row), space.pose_id(b_row)
+        found = search(space, a, b, rule) if rule is not None else None
+        if found is not None:
+            return ([int(space.sim.command_ids[s]) for s in found[0]], found[1], False, space.rows(a, found[0])), record
+        if len(cells) == n_free or rule is None:  # the whole map, or no rule to widen for
+            found = search(space, a, b, None)
+            if found is not None or len(cells) == n_free:
+                return (None if found is None else ([int(space.sim.command_ids[s]) for s in found[0]], found[1],
+                                                    monotone, space.rows(a, found[0]))), record
+        r *= 2
+
+
+def _finish_band_plan(ws: Workspace, commands: np.ndarray, rows: np.ndarray, ids, tables, timing, *,
+                      leg_ends, failed: int, began: float, info: dict) -> Plan:
+    """Re-validate a band plan step by step through :func:`~htetro_opt.model.simulate.transitions_at`
+    (the map is too large for the simulator's whole table) and wrap it as a :class:`Plan`."""
+    ids = list(ids)
+    if len(commands):
+        lookup = np.full(len(COMMANDS), -1, dtype=np.int64)
+        lookup[ids] = np.arange(len(ids))
+        local = lookup[commands]
+        table = transitions_at(ws, rows[:-1, :2], commands=ids, clearance=tables.clearance)
+        reached_ids = table[np.arange(len(commands)), rows[:-1, 2], rows[:-1, 3], local]
+        claimed = ((rows[1:, 2] * N_HEADINGS + rows[1:, 3]) * ws.height + rows[1:, 1]) * ws.width + rows[1:, 0]
+        wrong = np.flatnonzero(reached_ids != claimed)
+        if len(wrong):
+            raise PlanningError(f"internal error: the heat plan does not re-validate (command {int(wrong[0]) + 1} "
+                                f"of {len(commands)} is invalid)")
+    return Plan(method="heat", commands=commands, reached=failed < 0,
+                time=float(timing.durations()[commands].sum()), poses=rows, leg_ends=tuple(leg_ends),
+                failed_leg=int(failed), runtime_s=_time.perf_counter() - began, info=dict(info))

@@ -131,7 +131,11 @@ def test_default_commands_are_do_et_al_s_seventeen():
     ({"weights": (0, 0, 0)}, "not all be zero"),
     ({"weights": (1, -1, 0)}, "w_sm"),
     ({"weights": (1, float("nan"), 0)}, "w_sm"),
-    ({"weights": (1, 1, 0)}, "not available yet"),
+    ({"band": 0}, "band"),
+    ({"band": "narrow"}, "unknown band"),
+    ({"band_seed": "line"}, "unknown band_seed"),
+    ({"engine": "bfs"}, "unknown engine"),
+    ({"keep_fields": 1}, "keep_fields"),
     ({"t_max": 0}, "t_max"),
     ({"t_max": float("inf")}, "t_max"),
     ({"element": "p2"}, "unknown element"),
@@ -151,3 +155,135 @@ def test_moving_obstacles_and_short_roadmaps_are_refused():
         plan_heat(dynamic.workspace, dynamic.roadmap)
     with pytest.raises(PlanningError):
         plan_heat(Workspace(np.zeros((6, 6), dtype=bool)), [Pose(1, 1, "O", 0)])
+
+
+TABLE6 = [(1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (1.0, 1.0, 1.0)]
+
+
+def _surrogate(workspace, plan, weights, length):
+    """J of a one-leg plan from heat_fitness's exact eqs. 9-12 (an independent path to the same
+    number): Σ [w_t t/t_max + w_sm d/L + w_sf s/L] / Σw + 1e-9 Σt/t_max, the first command counted as a change."""
+    f = heat_fitness(workspace, plan.poses, plan.commands, t_max=plan.info["t_max"])
+    n = len(plan.commands)
+    time_part = 1.0 - f["f_t"]
+    changes = (1.0 - f["f_sm"]) * n + (1 if n else 0)
+    hazard = (1.0 - f["f_sf"]) * n
+    w_t, w_sm, w_sf = weights
+    return (w_t * time_part + (w_sm * changes + w_sf * hazard) / length) / sum(weights) + 1e-9 * time_part
+
+
+def _clutter(seed, size=16):
+    """A size x size map with 1-2-cell blocks, and O-shaped start and goal far apart on free cells."""
+    rng = np.random.default_rng(seed)
+    occ = np.zeros((size, size), dtype=bool)
+    while occ.mean() < 0.15:
+        w, h = rng.integers(1, 3, size=2)
+        x, y = rng.integers(0, size - w + 1), rng.integers(0, size - h + 1)
+        occ[y:y + h, x:x + w] = True
+    occ[:4, :4] = occ[size - 5:, size - 5:] = False  # room for the O-shapes (B2 at a corner of the square)
+    return Workspace(occ), [Pose(1, 1, "O", 0), Pose(size - 3, size - 3, "O", 0)]
+
+
+@pytest.mark.parametrize("name", ["random", "h_shape", "three_slit"])
+def test_each_weighting_minimises_its_own_cost_among_the_table6_plans(name):
+    scenario = load_scenario(name)
+    plans = {w: plan_heat(scenario.workspace, scenario.roadmap, weights=w) for w in TABLE6}
+    length = len(plans[(1.0, 0.0, 0.0)].commands)  # L: the time-only constrained plan's length
+    assert all(p.reached and p.info["relaxed"] == [False] for p in plans.values())
+    for w, plan in plans.items():
+        own = _surrogate(scenario.workspace, plan, w, length)
+        assert own == pytest.approx(plan.info["surrogate"][0], rel=1e-9, abs=1e-12)
+        for other in plans.values():
+            assert own <= _surrogate(scenario.workspace, other, w, length) + 1e-12
+    if name == "h_shape":  # where the weights matter, so that the comparisons above are not all ties
+        f = {w: p.info["fitness"] for w, p in plans.items()}
+        assert f[(0.0, 1.0, 0.0)]["f_sm"] > f[(1.0, 0.0, 0.0)]["f_sm"] + 0.05
+        assert f[(0.0, 0.0, 1.0)]["f_sf"] > f[(1.0, 0.0, 0.0)]["f_sf"] + 0.1
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("weights", TABLE6)
+def test_the_paper_s_waves_and_dijkstra_reach_the_same_optimum(seed, weights):
+    ws, roadmap = _clutter(seed)
+    waves = plan_heat(ws, roadmap, weights=weights, engine="wavefront")
+    heap = plan_heat(ws, roadmap, weights=weights)
+    assert waves.reached == heap.reached
+    if heap.reached:
+        assert waves.info["surrogate"] == pytest.approx(heap.info["surrogate"], rel=1e-12)
+        assert waves.info["relaxed"] == heap.info["relaxed"]
+        assert _replay(ws, waves, roadmap[0]) == roadmap[-1]
+
+
+@pytest.mark.parametrize("weights", TABLE6)
+def test_scaling_the_weights_keeps_the_plan(weights):
+    scenario = load_scenario("h_shape")
+    plan = plan_heat(scenario.workspace, scenario.roadmap, weights=weights)
+    scaled = plan_heat(scenario.workspace, scenario.roadmap, weights=tuple(3.5 * w for w in weights))
+    assert scaled.commands.tolist() == plan.commands.tolist()
+    again = plan_heat(scenario.workspace, scenario.roadmap, weights=weights)
+    assert again.commands.tolist() == plan.commands.tolist()  # deterministic
+
+
+@pytest.mark.parametrize("name", MAPS)
+@pytest.mark.parametrize("element", ["q1", "p0"])
+def test_a_band_search_revalidates_and_is_never_better_than_the_whole_graph(name, element):
+    scenario = load_scenario(name)
+    whole = plan_heat(scenario.workspace, scenario.roadmap, element=element, band="full")
+    assert whole.info["band"][0]["radius"] is None
+    for radius in (1, 3):
+        banded = plan_heat(scenario.workspace, scenario.roadmap, element=element, band=radius)
+        record = banded.info["band"][0]
+        assert banded.reached and record["seed"] == "ascent" and record["radius"] >= radius
+        assert _replay(scenario.workspace, banded, scenario.start) == scenario.goal
+        assert Simulator(scenario.workspace, diagonals=True).run([banded.commands], scenario.start).poses(0).tolist() \
+            == banded.poses.tolist()
+        assert banded.info["surrogate"][0] >= whole.info["surrogate"][0] - 1e-12
+        assert banded.info["relaxed"] == whole.info["relaxed"]
+
+
+def test_a_band_wide_enough_is_the_whole_search():
+    scenario = load_scenario("maze")
+    whole = plan_heat(scenario.workspace, scenario.roadmap, weights=(1, 1, 1))
+    banded = plan_heat(scenario.workspace, scenario.roadmap, weights=(1, 1, 1), band=48)
+    assert banded.info["band"][0]["cells"] == int((~scenario.workspace.occupancy).sum())
+    assert banded.commands.tolist() == whole.commands.tolist()
+    assert banded.info["fitness"] == pytest.approx(whole.info["fitness"])
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_widening_reaches_whenever_the_whole_search_does(seed):
+    ws, roadmap = _clutter(seed, size=20)
+    whole = plan_heat(ws, roadmap)
+    banded = plan_heat(ws, roadmap, band=1)
+    ablation = plan_heat(ws, roadmap, band=1, band_seed="grid_distance")
+    assert banded.reached == whole.reached == ablation.reached
+    if whole.reached:
+        assert banded.info["relaxed"] == whole.info["relaxed"]
+        assert banded.time >= whole.time - 1e-9 or banded.info["relaxed"] != [False]
+        assert _replay(ws, banded, roadmap[0]) == roadmap[-1]
+        assert ablation.info["band"][0]["seed"] in ("grid_distance", None)
+
+
+def test_a_band_with_no_path_in_the_map_reports_the_failed_leg():
+    occ = np.zeros((6, 12), dtype=bool)
+    occ[:, 5:7] = True
+    plan = plan_heat(Workspace(occ), [Pose(1, 1, "O", 0), Pose(9, 1, "O", 0)], band=2)
+    assert not plan.reached and plan.failed_leg == 0 and len(plan.commands) == 0
+    # no monotone path: the band widens to the whole map before the leg is relaxed
+    occ = np.zeros(100, dtype=bool)
+    occ[[12, 16, 18, 21, 26, 36, 38, 46, 47, 51, 60, 64, 72, 78, 80, 82, 88, 89, 91, 92]] = True
+    ws = Workspace(occ.reshape(10, 10))
+    roadmap = [Pose(4, 5, "O", 0), Pose(6, 7, "O", 0)]
+    banded, whole = plan_heat(ws, roadmap, band=1), plan_heat(ws, roadmap)
+    assert banded.info["relaxed"] == whole.info["relaxed"] == [True]
+    assert banded.info["band"][0]["cells"] == int((~ws.occupancy).sum())
+    assert banded.time == pytest.approx(whole.time)
+
+
+def test_kept_fields_are_the_legs_fields():
+    scenario = load_scenario("three_slit")
+    plan = plan_heat(scenario.workspace, scenario.roadmap, keep_fields=True)
+    (field,) = plan.info["fields"]
+    start, goal = scenario.start, scenario.goal
+    reference = solve_heat_field(scenario.workspace, (goal.x, goal.y), (start.x, start.y))
+    np.testing.assert_allclose(field.cells, reference.cells, atol=1e-10)
