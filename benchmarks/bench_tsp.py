@@ -8,8 +8,14 @@
 3. Scale: the 64 × 64 ``tiling_64x64`` map (~1000 waypoints): tiling time by both tiling methods,
    then every sequencing method's cost and time side by side (gap to the best), and the default
    (``auto``) tile + sequence time against the one-minute target.
+4. Backends: the outside solvers ``fast-tsp`` and ``lkh`` (LKH-3 through elkai), where installed,
+   beside the project's ``local`` (plain and iterated) and ``auto``: on two small TSPLIB instances with their
+   published optima (burma14, ulysses16, data inline), TSPLIB-like random uniform instances (integer
+   coordinates in [0, 10⁴), EUC_2D rounding, closed tours; no TSPLIB files are on this machine, so
+   LKH with one run is their reference) and the eq.-2 instance of tiling_64x64 (open path from
+   tile 1). Every cost is re-priced here from the matrix, independently of the solvers.
 
-Run:  python benchmarks/bench_tsp.py [--quick] [--parts agreement,ga,scale] [--seeds N]
+Run:  python benchmarks/bench_tsp.py [--quick] [--parts agreement,ga,scale,backends] [--seeds N] [--budget S]
 """
 
 from __future__ import annotations
@@ -23,6 +29,7 @@ import numpy as np
 
 from htetro_opt.problems import SequencingInstance, cost_matrix
 from htetro_opt.scenarios import list_tilesets, load_scenario, load_tileset, tileset_path
+from htetro_opt.scenarios.tsplib import parse_tsplib, tsplib_distances
 from htetro_opt.solvers.sequencing import sequence_waypoints
 from htetro_opt.solvers.tiling import TILING_METHODS, tile_workspace
 
@@ -122,11 +129,112 @@ def scale(quick: bool) -> None:
           f"(target < 60 s), cost {default.cost:.2f}.\n")
 
 
+BURMA14 = """NAME: burma14
+TYPE: TSP
+DIMENSION: 14
+EDGE_WEIGHT_TYPE: GEO
+NODE_COORD_SECTION
+1 16.47 96.10
+2 16.47 94.44
+3 20.09 92.54
+4 22.39 93.37
+5 25.23 97.24
+6 22.00 96.05
+7 20.47 97.02
+8 17.20 96.29
+9 16.30 97.38
+10 14.05 98.12
+11 16.53 97.38
+12 21.52 95.59
+13 19.41 97.13
+14 20.09 94.55
+EOF
+"""
+ULYSSES16 = """NAME: ulysses16
+TYPE: TSP
+DIMENSION: 16
+EDGE_WEIGHT_TYPE: GEO
+NODE_COORD_SECTION
+1 38.24 20.42
+2 39.57 26.15
+3 40.56 25.32
+4 36.26 23.12
+5 33.48 10.54
+6 37.56 12.19
+7 38.42 13.11
+8 37.52 20.44
+9 41.23 9.10
+10 41.17 13.05
+11 36.08 -5.21
+12 38.47 15.13
+13 38.15 15.35
+14 37.51 15.17
+15 35.49 14.32
+16 39.36 19.56
+EOF
+"""
+OPTIMA = {"burma14": 3323, "ulysses16": 6859}  # TSPLIB's published optima
+
+
+def _installed(module: str) -> bool:
+    try:
+        __import__(module)
+    except ImportError:
+        return False
+    return True
+
+
+def _tour_cost(cost: np.ndarray, order, closed: bool) -> float:
+    """The order's cost by a loop of our own, independent of every solver and of the instance's pricing."""
+    total = sum(float(cost[a, b]) for a, b in zip(order[:-1], order[1:]))
+    return total + (float(cost[order[-1], order[0]]) if closed else 0.0)
+
+
+def backends(quick: bool, budget: float) -> None:
+    have_fast, have_lkh = _installed("fast_tsp"), _installed("elkai")
+    print(f"## Backends: fast-tsp ({'installed' if have_fast else 'not installed'}) and LKH-3 via elkai "
+          f"({'installed' if have_lkh else 'not installed'}) beside the project's methods\n")
+    cases = [(t.name, SequencingInstance.from_matrix(t.cost, closed=True, start=0), OPTIMA[t.name])
+             for t in (parse_tsplib(BURMA14), parse_tsplib(ULYSSES16))]
+    for n, seed in ((200, 0), (1000, 1)) if quick else ((200, 0), (500, 1), (1000, 2), (2000, 3)):
+        xy = np.random.default_rng(seed).integers(0, 10_000, size=(n, 2))
+        cases.append((f"uniform {n} (EUC_2D, seed {seed})",
+                      SequencingInstance.from_matrix(tsplib_distances(xy, "EUC_2D"), closed=True, start=0), None))
+    scenario = load_scenario("tiling_64x64")
+    ts = tile_workspace(scenario.workspace, name=scenario.name)
+    cases.append(("tiling_64x64 eq. 2 (open, tile 1)", SequencingInstance.from_tileset(ts, start=1), None))
+    runs = [("local", {}), ("local", {"restarts": 10**6, "time_limit": budget})]
+    if have_fast:
+        runs += [("fast-tsp", {"time_limit": 1.0}), ("fast-tsp", {"time_limit": budget})]
+    if have_lkh:
+        runs.append(("lkh", {"runs": 1}))
+    reference = "LKH with one run" if have_lkh else "the row's best cost"
+    print(f"Gap in % to the published optimum (burma14, ulysses16), else to {reference}; seconds in brackets. "
+          "Closed tours except tiling_64x64.\n")
+    labels = [m + "".join(f", {k}={'∞' if v == 10**6 else f'{v:g}'}" for k, v in o.items()) for m, o in runs]
+    print("| instance | n | reference cost | " + " | ".join(labels) + " |")
+    print("|---|---:|---:|" + "---:|" * len(runs))
+    for name, inst, optimum in cases:
+        results = []
+        for method, options in runs:
+            r = sequence_waypoints(inst, method=method, seed=0, **options)
+            cost = _tour_cost(inst.cost, r.order.tolist(), inst.closed)
+            assert sorted(r.order.tolist()) == list(range(inst.n)) and abs(cost - r.cost) <= 1e-6 * max(1.0, cost)
+            if optimum is not None:
+                assert cost >= optimum - 1e-9, (name, method, cost)
+            results.append((cost, r.runtime_s))
+        best = optimum if optimum is not None else (results[-1][0] if have_lkh else min(c for c, _ in results))
+        cells = [f"{100 * (c - best) / best:.2f} ({t:.2f})" for c, t in results]
+        print(f"| {name} | {inst.n} | {best:.2f} | " + " | ".join(cells) + " |", flush=True)
+    print()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--parts", default="agreement,ga,scale")
     parser.add_argument("--seeds", type=int, default=5)
+    parser.add_argument("--budget", type=float, default=10.0, help="backends: the longer time budget in seconds")
     args = parser.parse_args()
     print(f"# Le et al. 2018 benchmark ({platform.python_version()}, {platform.processor() or platform.machine()})\n")
     parts = args.parts.split(",")
@@ -136,6 +244,8 @@ def main() -> None:
         ga(args.quick, 2 if args.quick else args.seeds)
     if "scale" in parts:
         scale(args.quick)
+    if "backends" in parts:
+        backends(args.quick, args.budget)
 
 
 if __name__ == "__main__":

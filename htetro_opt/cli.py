@@ -47,8 +47,11 @@ __all__ = ["main", "main_entry", "build_parser"]
 
 
 EXIT_ERROR = 2
-GA_DEFAULTS = {"pop_size": 50, "max_gen": 1000, "patience": 100, "max_length": None, "seed": 0}
-"""Defaults of ``plan``'s GA options (None in the parser, so that one given to an exact method is refused)."""
+GA_DEFAULTS = {"pop_size": 50, "max_gen": 1000, "patience": 100, "max_length": None, "seed": 0,
+               "replan_window": None, "replan_members": None, "seed_exact": False, "pick": "balanced"}
+"""Defaults of ``plan``'s GA options (None in the parser, so that one given to an exact method is refused;
+None here: plan_ga's default for the algorithm)."""
+GA_PICKS = ("balanced", "fastest", "smoothest", "safest")  # htetro_opt.algorithms.PICKS, without loading pymoo
 TILING_TIME_LIMIT = 60.0  # the backtracker can search long on cluttered maps with few allowed shapes
 
 
@@ -92,6 +95,18 @@ def build_parser() -> argparse.ArgumentParser:
                         "and twice the grid distance from the leg's start to its goal)")
     p.add_argument("--seed", type=int,
                    help=f"GA methods: random seed, the same seed giving the same plan (default {GA_DEFAULTS['seed']})")
+    p.add_argument("--replan-window", type=int, metavar="W",
+                   help="htetro-ga: windowed exact re-planning of ours, each generation a window of up to W executed "
+                        "commands of the fastest and of --replan-members random goal-reaching members replaced by the "
+                        "minimum-time path between its ends (default 40; 0: off; off in htetro-ga-paper)")
+    p.add_argument("--replan-members", type=int, metavar="K",
+                   help="htetro-ga: random goal-reaching members re-planned each generation besides the fastest (default 3)")
+    p.add_argument("--seed-exact", action="store_true", default=None,
+                   help="GA methods: put each leg's exact minimum-time plan into its initial population; the JSON "
+                        "then reports the gaps to the exact optimum")
+    p.add_argument("--pick", choices=GA_PICKS,
+                   help="GA methods: the solution each leg returns, balanced (default: the largest sum of the four "
+                        "fitnesses), or the best f_t, f_sm or f_sf")
     p.add_argument("--diagonals", action="store_true", help="dijkstra, astar: allow diagonal translations")
     p.add_argument("--weights", metavar="WT,WSM,WSF",
                    help="heat: weights of time, smoothness and safety (default 1,0,0)")
@@ -147,23 +162,35 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "sequence",
-        help="order a tileset's waypoints (the TSP of Le et al. 2018) with one method",
+        help="order a tileset's waypoints (the TSP of Le et al. 2018) or a TSPLIB instance with one method",
         description="Order the waypoints of a labelled tileset as an open path from a start tile, "
         "minimising the eq.-2 cost (weighted displacement of the blocks a-d). TILESET is a labelled "
-        "tileset (bundled name or file) or a scenario, which is tiled first.",
+        "tileset (bundled name or file) or a scenario, which is tiled first, or a TSPLIB file (.tsp, .atsp), "
+        "whose nodes are ordered as a closed tour by default, priced under TSPLIB's rounding.",
     )
-    p.add_argument("tileset", help="labelled tileset (bundled name or file) or scenario (name or .toml)")
+    p.add_argument("tileset", metavar="TILESET",
+                   help="labelled tileset (bundled name or file), scenario (name or .toml) or TSPLIB file (.tsp)")
     p.add_argument("--method", choices=SEQUENCE_METHODS, default="auto",
-                   help="auto (default): exact up to 40 waypoints, local search beyond; ga: the paper's GA "
+                   help="auto (default): exact up to 40 waypoints, local beyond ("
+                        "ortools for asymmetric costs); ga: the paper's GA "
                         "on DEAP with a 2-opt/Or-opt step (ga-plain: without); ortools: routing with "
                         "guided local search; exact: CP-SAT optimum (<= 40 waypoints); local: nearest "
-                        "neighbour + 2-opt/Or-opt; zigzag, zigzag2, spiral, spiral2, greedy: the paper's baselines")
-    p.add_argument("--start", default="1", help="label of the start tile (default 1), or 'free'")
-    p.add_argument("--weights", default="0.25,0.25,0.25,0.25",
-                   help="eq. 2's weights α,β,λ,γ of blocks a,b,c,d (default 0.25 each)")
+                        "neighbour + 2-opt/Or-opt; zigzag, zigzag2, spiral, spiral2, greedy: the paper's baselines; "
+                        "fast-tsp: the fast-tsp package (optional, MIT); lkh: LKH-3 through the elkai package "
+                        "(optional; non-commercial use only)")
+    p.add_argument("--start", default="1", help="label of the start tile or TSPLIB node (default 1), or 'free'")
+    p.add_argument("--end", help="open paths: label of the tile or TSPLIB node the order ends at (default: free)")
+    tour = p.add_mutually_exclusive_group()
+    tour.add_argument("--closed", action="store_true",
+                      help="a closed tour, back to the start (the default for TSPLIB files)")
+    tour.add_argument("--open", action="store_true", help="an open path (the default for tilesets)")
+    p.add_argument("--weights", help="tilesets: eq. 2's weights α,β,λ,γ of blocks a,b,c,d (default 0.25 each)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0; deterministic methods ignore it)")
     p.add_argument("--time-limit", type=float,
                    help=f"time budget in seconds; by default, sized to the instance: {TIME_LIMIT_TEXT}")
+    p.add_argument("--restarts", type=int,
+                   help="local (and auto when it runs local): kicks of the iterated local search (default 0)")
+    p.add_argument("--runs", type=int, help="lkh: LKH's independent runs, the best kept (default 1)")
     p.add_argument("--shapes", help="when TILESET is a scenario: allowed morphologies for the tiling")
     _add_outputs(p, plot="a plot of the tileset and the order")
     p = sub.add_parser(
@@ -172,9 +199,10 @@ def build_parser() -> argparse.ArgumentParser:
         description="Run a study: a bundled one by name (small, table4, sequencing) or a study TOML file "
         "(task, scenarios, seeds, [[methods]] with the command's options), every trial recorded to "
         "DIR/NAME.jsonl as it ends, then summarised per scenario and method (mean, std, median, success "
-        "rate, gap to the exact reference). 'seed003' re-runs the tables of Le et al. 2018 beside the paper's.",
+        "rate, gap to the exact reference). 'le2018' re-runs the tables of Le et al. 2018 beside the paper's; "
+        "'do2021' those of Do et al. 2021 (Tables 6-8, Fig. 13; DIR/do2021.md and .csv hold its report).",
     )
-    p.add_argument("study", metavar="NAME|FILE", help="a bundled study name, seed003, or a study TOML file")
+    p.add_argument("study", metavar="NAME|FILE", help="a bundled study name, do2021, le2018, or a study TOML file")
     p.add_argument("--executor", choices=("serial", "processes", "dask"), default="processes",
                    help="where trials run: this process, local worker processes (default), or a Dask cluster")
     p.add_argument("--workers", type=int, help="processes / dask: number of workers (default: the local cores)")
@@ -185,8 +213,37 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true", help="skip the trials already recorded in DIR/NAME.jsonl")
     p.add_argument("--retries", type=int, default=0, help="re-run a failing trial up to N times (default 0)")
     p.add_argument("--time-limit", type=float,
-                   help="seed003 only: cap in seconds for each method that takes one (a study file sets its own)")
+                   help="le2018 only: cap in seconds for each method that takes one (a study file sets its own)")
     _add_outputs(p, json="print one JSON object instead of the summary table")
+
+    p = sub.add_parser(
+        "cover",
+        help="plan complete coverage of a scenario (Cheng et al. 2019)",
+        description="Plan commands (Cheng et al. 2019's 13) that cover every free cell the robot can cover in the "
+        "allowed morphology layers: stripes of rows cut into regions, each searched for its cheapest covering walk, "
+        "joined by one auxiliary DAG; or a one-layer boustrophedon. Cells no allowed pose covers are reported.",
+    )
+    p.add_argument("scenario", help="bundled scenario name or path to a scenario TOML file")
+    p.add_argument("--method", choices=("stripes", "boustrophedon"), default="stripes",
+                   help="stripes (default): the paper's stripes, regions and auxiliary DAG; boustrophedon: lanes in "
+                        "the first layer, the baseline")
+    p.add_argument("--shapes", default="O,vI,hI",
+                   help="morphology layers: O, vI, hI or SHAPE@H, comma-separated (default O,vI,hI)")
+    p.add_argument("--stripes", default="4",
+                   help="stripe width W (H // W bands, the last taking the remainder) or widths bottom up, e.g. "
+                        "2,3,2 (default 4)")
+    p.add_argument("--region-columns", type=int, default=4, help="columns of a region (default 4)")
+    p.add_argument("--budget", type=int, default=20_000,
+                   help="search nodes per region before its greedy walk is taken (default 20000)")
+    p.add_argument("--start", choices=("scenario", "auto"), default="scenario",
+                   help="scenario (default): the roadmap's first pose as start and last as goal (auto when the "
+                        "scenario has none); auto: the bottom-left pose of the first layer, a free end")
+    p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block (default 0)")
+    p.add_argument("--time-limit", type=float,
+                   help="seconds; past them the remaining regions take their greedy walk (default: none)")
+    _add_outputs(p, plot="a plot of the map, the stripes, the regions and the plan (the paper's Figs. 14a, 15a)")
+    p.add_argument("--coverage-plot", metavar="FILE",
+                   help="save the pixel coverage times and their histogram (the paper's Figs. 14b-c, 15b-c)")
     return parser
 
 
@@ -344,7 +401,11 @@ def _cmd_plan(args) -> dict:
                        max_gen=check_int(args.max_gen, "--max-gen", minimum=1),
                        patience=check_int(args.patience, "--patience", minimum=1),
                        max_length=check_int(args.max_length, "--max-length", minimum=1, allow_none=True),
-                       seed=check_int(args.seed, "--seed", minimum=0))
+                       seed=check_int(args.seed, "--seed", minimum=0),
+                       seed_exact=bool(args.seed_exact), pick=args.pick)
+        for name in ("replan_window", "replan_members"):  # None: the algorithm's default
+            if getattr(args, name) is not None:
+                options[name] = check_int(getattr(args, name), "--" + name.replace("_", "-"), minimum=0)
     else:
         if given:
             flags = ", ".join("--" + name.replace("_", "-") for name in given)
@@ -414,14 +475,20 @@ def _cmd_plan(args) -> dict:
             first = out["reach_generation"]
             print(f"generations {out['generations']}, goal first reached "
                   f"{'in generation ' + str(first) if first is not None else 'in no generation'}; "
-                  f"multi-objective solution: {fitness}; leading front: {len(out['front'])} members")
+                  f"{'multi-objective' if args.pick == 'balanced' else args.pick} solution: {fitness}; "
+                  f"leading front: {len(out['front'])} members")
+            if "gap" in out:
+                print(f"gap to the exact optimum ({out['gap']['exact']:g} s): {args.pick} {out['gap']['picked']:.1%}, "
+                      f"fastest {out['gap']['fastest']:.1%}")
         if plan.tokens:
             print(" ".join(plan.tokens))
     return out
 
 
 def _ga_fields(plan, args) -> dict:
-    """The GA's extra JSON fields: the last leg's front, and every leg's record."""
+    """The GA's extra JSON fields: the last leg's front, every leg's record, and with --seed-exact the
+    gaps of the returned plan and of the legs' fastest members to the exact optimum."""
+    from htetro_opt.algorithms import PICKS
     legs = [
         {
             "start": leg.start.as_dict(),
@@ -436,16 +503,24 @@ def _ga_fields(plan, args) -> dict:
         }
         for leg in plan.legs
     ]
-    fitness = np.mean([leg.selected["multi_objective"].fitness for leg in plan.legs], axis=0)
-    return {
+    fitness = np.mean([leg.selected[PICKS[args.pick]].fitness for leg in plan.legs], axis=0)
+    out = {
         "pop_size": args.pop_size,
         "seed": args.seed,
+        "pick": args.pick,
         "reach_generation": plan.reach_generation,
         "generations": sum(leg.generations for leg in plan.legs),
         "fitness": {name: float(v) for name, v in zip(FITNESS_NAMES, fitness)},
         "front": legs[-1]["front"],
         "legs": legs,
     }
+    exact = plan.info.get("exact_times")
+    if exact is not None and plan.reached and None not in exact and sum(exact) > 0:
+        # each leg's optimum from where and when the returned plan starts it
+        fastest = sum(leg.selected["time"].time for leg in plan.legs)
+        out["gap"] = {"exact": float(sum(exact)), "picked": (plan.time - sum(exact)) / sum(exact),
+                      "fastest": (fastest - sum(exact)) / sum(exact)}
+    return out
 
 
 def _cmd_simulate(args) -> dict:
@@ -607,19 +682,57 @@ def _is_scenario(name: str) -> bool:
     return name in list_scenarios()
 
 
+def _is_tsplib(name: str) -> bool:
+    return name.lower().endswith((".tsp", ".atsp"))
+
+
+def _label(text: str | None, flag: str, *, free: bool) -> int | None:
+    """``--start`` / ``--end``: a tile or node label, or 'free'."""
+    if text is None or (free and text == "free"):
+        return None
+    try:
+        return int(text)
+    except ValueError as err:
+        raise ParameterError(f"{flag} must be a tile label{' or ' + repr('free') if free else ''}, got {text!r}") from err
+
+
+def _index_of(label: int | None, ids, flag: str, what: str) -> int | None:
+    if label is None:
+        return None
+    try:
+        return list(ids).index(label)
+    except ValueError:
+        raise ParameterError(f"{flag} {label}: there is no {what} {label}") from None
+
+
+def _sequence_options(args, instance) -> dict:
+    """``--restarts`` and ``--runs``, each only for the method that has it."""
+    from htetro_opt.solvers.sequencing import auto_method
+
+    options = {}
+    runs = auto_method(instance) if args.method == "auto" else args.method
+    if args.restarts is not None:
+        if runs != "local":
+            raise ParameterError(f"--restarts applies to --method local (auto runs it above 40 waypoints); "
+                                 f"here the method is {runs}")
+        options["restarts"] = check_int(args.restarts, "--restarts", minimum=0)
+    if args.runs is not None:
+        if runs != "lkh":
+            raise ParameterError(f"--runs applies to --method lkh; here the method is {runs}")
+        options["runs"] = check_int(args.runs, "--runs", minimum=1)
+    return options
+
+
 def _cmd_sequence(args) -> dict:
     time_limit = _cli_time_limit(args.time_limit)
     seed = check_int(args.seed, "--seed", minimum=0)
     _outputs(args, ("plot", "plot"))
-    weights = _weights(args.weights)
-    if args.start == "free":
-        start = None
-    else:
-        try:
-            start = int(args.start)
-        except ValueError as err:
-            raise ParameterError(f"--start must be a tile label or 'free', got {args.start!r}") from err
+    start = _label(args.start, "--start", free=True)
+    end = _label(args.end, "--end", free=False)
     console = _console(args)
+    if _is_tsplib(args.tileset):
+        return _sequence_tsplib(args, console, start=start, end=end, time_limit=time_limit, seed=seed)
+    weights = _weights(args.weights or "0.25,0.25,0.25,0.25")
     if _is_scenario(args.tileset):
         scenario_path(args.tileset)  # a clear error for a missing file
         with console.step("tiling (backtracking)"):
@@ -631,9 +744,15 @@ def _cmd_sequence(args) -> dict:
         tileset = load_tileset(tileset_path(args.tileset))
         name = Path(args.tileset).stem  # the name the user gave, never an install path
     instance = SequencingInstance.from_tileset(tileset, start=start, weights=weights)
+    if args.closed or end is not None:
+        instance = SequencingInstance(instance.cost, instance.blocks, instance.start, instance.ids, instance.shape,
+                                      closed=args.closed, end=_index_of(end, instance.ids, "--end", "tile"))
+    options = _sequence_options(args, instance)
     with console.step(f"sequencing {instance.n} waypoints ({args.method})") as progress:
-        result = sequence_waypoints(instance, method=args.method, seed=seed, time_limit=time_limit, progress=progress)
+        result = sequence_waypoints(instance, method=args.method, seed=seed, time_limit=time_limit, progress=progress,
+                                    **options)
     out = {"tileset": name, "waypoints": instance.n, "start": args.start, "weights": weights.tolist(),
+           **({"closed": True} if args.closed else {}), **({"end": args.end} if end is not None else {}),
            **result.as_dict()}
     if args.plot:
         from htetro_opt.viz import plot_tileset
@@ -644,6 +763,36 @@ def _cmd_sequence(args) -> dict:
     if not args.json:
         print(f"{name}: {instance.n} waypoints, {result.method}, cost {result.cost:.4f} "
               f"in {result.runtime_s:.3f} s")
+        print(" ".join(str(t) for t in result.tiles))
+    return out
+
+
+def _sequence_tsplib(args, console, *, start, end, time_limit, seed) -> dict:
+    """``sequence FILE.tsp``: the nodes as a closed tour (``--open``: a path), costs under TSPLIB's rounding."""
+    from htetro_opt.scenarios.tsplib import load_tsplib
+
+    for flag, given in (("--weights", args.weights), ("--shapes", args.shapes), ("--plot", args.plot)):
+        if given:
+            raise ParameterError(f"{flag} does not apply to a TSPLIB file (it has no tiles)")
+    tsp = load_tsplib(args.tileset)
+    closed = not args.open
+    if closed and end is not None:
+        raise ParameterError("--end applies to open paths: add --open (a TSPLIB file is a closed tour by default)")
+    nodes = range(1, tsp.dimension + 1)
+    instance = SequencingInstance.from_matrix(tsp.cost, closed=closed, start=_index_of(start, nodes, "--start", "node"),
+                                              end=_index_of(end, nodes, "--end", "node"))
+    options = _sequence_options(args, instance)
+    with console.step(f"sequencing {instance.n} nodes ({args.method})") as progress:
+        result = sequence_waypoints(instance, method=args.method, seed=seed, time_limit=time_limit, progress=progress,
+                                    **options)
+    record = result.as_dict()
+    if float(result.cost).is_integer():  # TSPLIB's costs are integers: so is every tour's
+        record["cost"] = int(result.cost)
+    out = {"tsplib": tsp.name, "type": tsp.type, "edge_weight_type": tsp.edge_weight_type, "waypoints": instance.n,
+           "closed": closed, "start": args.start, **({"end": args.end} if end is not None else {}), **record}
+    if not args.json:
+        print(f"{tsp.name}: {instance.n} nodes, {'closed tour' if closed else 'open path'}, {result.method}, "
+              f"cost {record['cost']} in {result.runtime_s:.3f} s")
         print(" ".join(str(t) for t in result.tiles))
     return out
 
@@ -674,12 +823,12 @@ def _study_folder(out: str | None) -> Path | None:
 
 
 def _cmd_study(args) -> dict:
-    if args.study == "seed003":
-        return _seed003(args)
+    if args.study == "le2018":
+        return _le2018(args)
     from htetro_opt.studies.runner import load_study, run_study
 
     if args.time_limit is not None:
-        raise ParameterError("--time-limit applies to seed003 only; a study file sets each method's time_limit")
+        raise ParameterError("--time-limit applies to le2018 only; a study file sets each method's time_limit")
     if args.scheduler and args.executor != "dask":
         raise ParameterError("--scheduler applies only with --executor dask")
     if args.resume and not args.out:
@@ -689,6 +838,8 @@ def _cmd_study(args) -> dict:
     workers = check_int(args.workers, "--workers", minimum=1, allow_none=True)
     retries = check_int(args.retries, "--retries", minimum=0)
     out = _study_folder(args.out)
+    if study.name == "do2021":  # Do et al. 2021: Tables 6-7 on the runner, Table 8 and Fig. 13 beside them
+        return _do2021(args, study, seeds, workers, retries, out)
     # Table 4 of Cheng et al. 2020 records the paper's own measures, and its report sets them beside the paper's
     paper = None
     if study.name == "table4":
@@ -711,15 +862,40 @@ def _cmd_study(args) -> dict:
     return run.as_dict()
 
 
-def _seed003(args) -> dict:
+def _do2021(args, study, seeds, workers, retries, out) -> dict:
+    """Do et al. 2021's Tables 6-8 and Fig. 13 beside the paper's: Tables 6 and 7 on the study runner
+    (the bundled study, or a study file named do2021), Table 8 and Fig. 13 (single runs) in this process;
+    DIR/do2021.md and DIR/do2021.csv hold the report."""
+    from htetro_opt.studies import do2021
+
+    console = _console(args)
+    with console.step("do2021 study (Tables 6, 7)", 1, "trials") as progress:
+        run = do2021.run_do2021(study.seeds if seeds is None else seeds, study=study, executor=args.executor,
+                                  workers=workers, scheduler=args.scheduler, out=out, resume=args.resume,
+                                  retries=retries, progress=progress)
+    if run.dashboard and not args.quiet:
+        print(f"dask dashboard: {run.dashboard}", file=sys.stderr)
+    with console.step("do2021 Table 8 and Fig. 13"):
+        table8, fig13 = do2021.run_table8(), do2021.run_fig13()
+    result = {**run.as_dict(), "table8": table8, "fig13": fig13}
+    if out is not None:
+        _late(result, lambda: do2021.write_report(out, run, table8=table8, fig13=fig13))
+    if not args.json:
+        print(do2021.report(run, table8=table8, fig13=fig13), end="")
+        if run.path is not None:
+            print(f"\n{len(run.records)} trials ({run.failed} failed) recorded in {run.path}")
+    return result
+
+
+def _le2018(args) -> dict:
     """Le et al. 2018's Tables 1–5 beside the paper's: Tables 1, 2, 4 and 5 on the study runner, Table 3
     (tilings shuffled by seed, which a sequencing study cannot express) in this process."""
-    from htetro_opt.studies import seed003
+    from htetro_opt.studies import le2018
 
     if args.scheduler:
-        raise ParameterError("--scheduler does not apply to seed003 (processes or serial)")
+        raise ParameterError("--scheduler does not apply to le2018 (processes or serial)")
     if args.executor == "dask":
-        raise ParameterError("--executor dask does not apply to seed003 (processes or serial)")
+        raise ParameterError("--executor dask does not apply to le2018 (processes or serial)")
     if args.resume and not args.out:
         raise ParameterError("--resume needs --out DIR, the folder holding the study's results")
     seeds = list(range(check_int(5 if args.seeds is None else args.seeds, "--seeds", minimum=1)))
@@ -727,22 +903,62 @@ def _seed003(args) -> dict:
     workers = check_int(args.workers, "--workers", minimum=1, allow_none=True)
     out = _study_folder(args.out)
     console = _console(args)
-    with console.step("seed003 study", 1, "trials") as progress:
-        run = seed003.run_seed003(seeds, time_limit=time_limit, executor=args.executor, workers=workers,
+    with console.step("le2018 study", 1, "trials") as progress:
+        run = le2018.run_le2018(seeds, time_limit=time_limit, executor=args.executor, workers=workers,
                                   out=out, resume=args.resume, progress=progress)
-    with console.step("seed003 Table 3 (our tilings)"):
-        table3 = seed003.run_table3(seeds=seeds[:2])  # two seeds, as the study always ran it
-    text = seed003.report(run, table3=table3) + "\n"
+    with console.step("le2018 Table 3 (our tilings)"):
+        table3 = le2018.run_table3(seeds=seeds[:2])  # two seeds, as the study always ran it
+    text = le2018.report(run, table3=table3) + "\n"
     result = {**run.as_dict(), "table3": table3}
     if out is not None:
-        _late(result, lambda: write_text(out / "seed003_paper.md", text, what="study report"))
+        _late(result, lambda: write_text(out / "le2018_paper.md", text, what="study report"))
     if not args.json:
         print(text, end="")
     return result
 
 
+def _cmd_cover(args) -> dict:
+    from htetro_opt.solvers.coverage import plan_coverage
+
+    _outputs(args, ("plot", "plot"), ("coverage_plot", "coverage plot"))
+    if args.coverage_plot:
+        from htetro_opt.viz import figure_format
+
+        figure_format(args.coverage_plot)
+    scenario = _grid_scenario(args.scenario)
+    clearance = _check_clearance(args.clearance)
+    time_limit = _cli_time_limit(args.time_limit)
+    region_columns = check_int(args.region_columns, "--region-columns", minimum=1)
+    budget = check_int(args.budget, "--budget", minimum=1)
+    start = goal = None
+    if args.start == "scenario" and scenario.roadmap:
+        start, goal = scenario.start, scenario.goal
+    console = _console(args)
+    with console.step(f"covering ({args.method})"):
+        plan = plan_coverage(scenario.workspace, args.shapes, method=args.method, stripes=args.stripes, start=start,
+                             goal=goal, region_columns=region_columns, budget=budget, clearance=clearance,
+                             time_limit=time_limit)
+    out = {"scenario": scenario.name, **plan.as_dict()}
+    title = f"{scenario.name}: {args.method}"
+    if args.plot:
+        from htetro_opt.viz import plot_cover
+
+        _late(out, lambda: _save_plot(console, lambda: plot_cover(scenario.workspace, plan, title=title), args.plot))
+    if args.coverage_plot:
+        from htetro_opt.viz import plot_cover_heat
+
+        _late(out, lambda: _save_plot(console, lambda: plot_cover_heat(plan, title=title), args.coverage_plot))
+    if not args.json:
+        state = "complete" if plan.complete else f"incomplete ({len(plan.uncoverable)} free cells uncoverable)"
+        print(f"{scenario.name}: {args.method} with {','.join(plan.layers)}: {plan.action_cost} commands, {state}, "
+              f"average coverage time {plan.average_coverage_time:.3f}, {plan.regions_optimal} of {plan.regions} "
+              f"region searches optimal, {plan.runtime_s:.3f} s")
+        print(",".join(plan.tokens))
+    return out
+
+
 _COMMANDS = {"scenarios": _cmd_scenarios, "plan": _cmd_plan, "simulate": _cmd_simulate,
-             "tile": _cmd_tile, "sequence": _cmd_sequence, "study": _cmd_study}
+             "tile": _cmd_tile, "sequence": _cmd_sequence, "study": _cmd_study, "cover": _cmd_cover}
 
 
 class Terminated(BaseException):

@@ -943,8 +943,8 @@ def test_bad_study_files_are_one_error_line_and_write_nothing(capsys, tmp_path, 
 @pytest.mark.parametrize("argv,words", [
     (["study", "small", "--scheduler", "tcp://127.0.0.1:1"], ["--scheduler", "dask"]),
     (["study", "small", "--resume"], ["--resume", "--out"]),
-    (["study", "small", "--time-limit", "3"], ["--time-limit", "seed003"]),
-    (["study", "seed003", "--executor", "dask"], ["--executor", "seed003"]),
+    (["study", "small", "--time-limit", "3"], ["--time-limit", "le2018"]),
+    (["study", "le2018", "--executor", "dask"], ["--executor", "le2018"]),
     (["study", "nonesuch"], ["nonesuch"]),
 ])
 def test_study_options_that_do_not_fit_are_refused(capsys, argv, words):
@@ -964,17 +964,17 @@ def test_study_table4_prints_ours_beside_the_papers(capsys, tmp_path):
     assert report.startswith("| environment") and report in out
 
 
-def test_study_seed003_runs_on_the_runner_and_resumes(capsys, tmp_path):
+def test_study_le2018_runs_on_the_runner_and_resumes(capsys, tmp_path):
     out_dir = tmp_path / "out"
-    argv = ["study", "seed003", "--seeds", "1", "--time-limit", "0.5", "--out", str(out_dir)]
+    argv = ["study", "le2018", "--seeds", "1", "--time-limit", "0.5", "--out", str(out_dir)]
     code, out, err = run(capsys, argv)
     assert code == 0, err
     assert out.count("### Table") >= 5 and "Exact (CP-SAT)" in out
-    assert sorted(p.name for p in out_dir.iterdir()) == ["seed003.csv", "seed003.jsonl", "seed003.md",
-                                                         "seed003_paper.md"]
-    lines = (out_dir / "seed003.jsonl").read_text().splitlines()
+    assert sorted(p.name for p in out_dir.iterdir()) == ["le2018.csv", "le2018.jsonl", "le2018.md",
+                                                         "le2018_paper.md"]
+    lines = (out_dir / "le2018.jsonl").read_text().splitlines()
     again = run_json(capsys, [*argv, "--resume", "--json"])  # nothing left to run: the same records
-    assert again["trials"] == len(again["records"]) and (out_dir / "seed003.jsonl").read_text().splitlines() == lines
+    assert again["trials"] == len(again["records"]) and (out_dir / "le2018.jsonl").read_text().splitlines() == lines
 
 
 # --------------------------------------------------------------------------------------------------
@@ -1033,3 +1033,77 @@ def test_plan_heat_with_a_sensor_replans_in_the_true_world(capsys, tmp_path):
     replay = run_json(capsys, ["simulate", "maze_partial", "--commands", ",".join(out["commands"]), "--json"])
     assert replay["reached"] is True and replay["time"] == pytest.approx(out["time"])
     assert png.stat().st_size > 10_000 and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+# --------------------------------------------------------------------------------------------------
+# cover (Cheng et al. 2019)
+
+
+def test_cover_json_keys_and_replay(capsys):
+    out = run_json(capsys, ["cover", "coverage_16x7", "--shapes", "O,hI", "--stripes", "2,3,2", "--json"])
+    assert {"scenario", "method", "shapes", "stripes", "start", "goal", "complete", "free", "coverable", "covered",
+            "uncoverable", "action_cost", "time", "commands", "coverage_pct", "recovered_pct", "average_coverage_time",
+            "coverable_pct", "path_length", "switches", "turns", "regions", "regions_optimal", "mopup_commands",
+            "stripes_detail", "time_limited", "runtime_s"} <= set(out)
+    assert out["coverable_pct"] == 100.0 and 0 < out["recovered_pct"] < 100
+    # every command covers 4 cells' worth of pixels for one unit: the average over the free cells follows
+    assert out["average_coverage_time"] == pytest.approx(4 * out["time"] / out["free"], rel=0.01)
+    assert out["complete"] is False and out["uncoverable"] == [{"x": 0, "y": 0, "reason": "no-fit"}]
+    assert out["covered"] == out["coverable"] == out["free"] - 1 and out["action_cost"] == len(out["commands"])
+    assert out["stripes"] == [2, 3, 2] and out["stripes_detail"][-1]["borrowed"] >= 1
+    replay = run_json(capsys, ["simulate", "coverage_16x7", "--commands", ",".join(out["commands"]), "--json"])
+    assert replay["valid"] is True and replay["time"] == pytest.approx(out["time"])
+
+
+def test_cover_boustrophedon_and_auto_start(capsys):
+    stripes = run_json(capsys, ["cover", "coverage_16x16", "--shapes", "O", "--json"])
+    bous = run_json(capsys, ["cover", "coverage_16x16", "--method", "boustrophedon", "--shapes", "O", "--json"])
+    assert stripes["complete"] and bous["complete"] and stripes["action_cost"] <= bous["action_cost"]
+    assert stripes["goal"] is None and bous["method"] == "boustrophedon"
+    code, out, err = run(capsys, ["cover", "coverage_16x7", "--start", "auto", "--shapes", "O,hI"])
+    assert code == 0 and "commands" in out.splitlines()[0]
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["--shapes", "Q"], ["Q", "SHAPE@H"]),
+    (["--stripes", "3,3"], ["sum"]),
+    (["--stripes", "0"], ["stripes"]),
+    (["--region-columns", "0"], ["--region-columns"]),
+    (["--budget", "0"], ["--budget"]),
+    (["--time-limit", "0"], ["--time-limit"]),
+    (["--shapes", "hI"], ["start", "--shapes"]),  # the roadmap's start is an O
+    (["--method", "zigzag"], ["zigzag"]),
+])
+def test_cover_bad_options(capsys, argv, words):
+    assert_one_error_line(*run(capsys, ["cover", "coverage_16x7", *argv]), *words)
+
+
+def test_cover_refuses_a_continuous_scenario(capsys, tmp_path):
+    path = tmp_path / "c.toml"
+    path.write_text('width = 10.0\nheight = 10.0\nrobot_radius = 0.1\nobstacles = []\n'
+                    '[[robots]]\nstart = [1.0, 1.0]\ngoal = [9.0, 9.0]\n')
+    assert_one_error_line(*run(capsys, ["cover", str(path)]), "continuous")
+
+
+def test_cover_plots(capsys, tmp_path):
+    png, svg = tmp_path / "cover.png", tmp_path / "heat.svg"
+    out = run_json(capsys, ["cover", "coverage_16x7", "--shapes", "O,hI", "--stripes", "2,3,2", "--json",
+                            "--plot", str(png), "--coverage-plot", str(svg)])
+    assert out["complete"] is False
+    assert png.read_bytes().startswith(PNG_SIGNATURE) and svg.read_bytes().startswith(b"<?xml")
+
+
+@pytest.mark.parametrize("flag,name,words", [
+    ("--plot", "no/c.png", ["cannot write plot"]),
+    ("--coverage-plot", "no/c.png", ["cannot write coverage plot"]),
+    ("--coverage-plot", "c.docx", ["docx"]),
+])
+def test_cover_checks_plot_paths_before_planning(capsys, tmp_path, monkeypatch, flag, name, words):
+    import htetro_opt.solvers.coverage as coverage
+
+    def must_not_run(*args, **kwargs):
+        raise AssertionError("planned before checking the output path")
+
+    monkeypatch.setattr(coverage, "plan_coverage", must_not_run)
+    assert_one_error_line(*run(capsys, ["cover", "coverage_16x7", flag, str(tmp_path / name)]), *words)
+    assert list(tmp_path.iterdir()) == []

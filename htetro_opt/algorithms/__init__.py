@@ -15,6 +15,6 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "HTetroGA": ".htetro_ga", "trim_reached": ".htetro_ga",
     "FrontConvergence": ".termination",
     "GA_ALGORITHMS": ".factory", "make_algorithm": ".factory",
-    "SELECTIONS": ".solutions", "leading_front": ".solutions", "select_solutions": ".solutions",
+    "SELECTIONS": ".solutions", "PICKS": ".solutions", "leading_front": ".solutions", "select_solutions": ".solutions",
     "ConvergenceRecorder": ".solutions",
 })

@@ -8,7 +8,7 @@ study can swap the algorithm and nothing else.
 from __future__ import annotations
 
 from math import comb
-from typing import Mapping
+from typing import Mapping, Sequence
 
 from htetro_opt._validation import check_int, check_probability
 from htetro_opt.algorithms.htetro_ga import HTetroGA
@@ -34,13 +34,16 @@ def make_algorithm(
     *,
     sampling_weights: Mapping[str, float] | None = None,
     crossover_rate: float = 0.5,
+    replan_window: int | None = None,
+    replan_members: int | None = None,
+    include: Sequence = (),
 ):
     """A pymoo algorithm over command chromosomes.
 
     Parameters
     ----------
     name : {"htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea"}
-        ``"htetro-ga"`` is :class:`HTetroGA` with our repair, shortcut and niching, ``"htetro-ga-paper"``
+        ``"htetro-ga"`` is :class:`HTetroGA` with our repair, shortcut, niching and re-planning, ``"htetro-ga-paper"``
         :meth:`HTetroGA.as_published`; the others are pymoo's algorithms with the command sampling,
         single-point crossover (rate ``crossover_rate``), mutation, duplicate elimination and the
         repair (NSGA-III with Das–Dennis reference directions, about ``pop_size`` of them).
@@ -48,12 +51,19 @@ def make_algorithm(
     sampling_weights : mapping of token to float, optional
         λ_mc of Algorithm 1.
     crossover_rate : float
+    replan_window, replan_members : int, optional
+        The hTetro-GA's windowed exact re-planning (:class:`HTetroGA`); None: the algorithm's
+        default (W = 40 and 3 members for ``"htetro-ga"``, off for ``"htetro-ga-paper"``). pymoo's
+        algorithms have no re-planning step (yet): a window other than 0 is refused there.
+    include : sequence of int arrays
+        Chromosomes put into the initial population (:class:`CommandSampling`'s ``include``).
 
     Raises
     ------
     ParameterError
         If the name is unknown, ``pop_size`` is below 2, ``crossover_rate`` is not a probability, a
-        sampling weight is negative, or ``"agemoea"`` is asked for without numba installed (pymoo's
+        sampling weight is negative, ``replan_window`` or ``replan_members`` is negative or given to
+        one of pymoo's algorithms, or ``"agemoea"`` is asked for without numba installed (pymoo's
         AGE-MOEA needs it: the ``agemoea`` extra).
 
     Examples
@@ -65,11 +75,15 @@ def make_algorithm(
         raise ParameterError(f"unknown algorithm {name!r}: expected one of {', '.join(GA_ALGORITHMS)}")
     pop_size = check_int(pop_size, "pop_size", minimum=2)
     crossover_rate = check_probability(crossover_rate, "crossover_rate")
-    sampling = CommandSampling(sampling_weights)
+    sampling = CommandSampling(sampling_weights, include=include)
+    replan = {key: check_int(value, key, minimum=0) for key, value in
+              (("replan_window", replan_window), ("replan_members", replan_members)) if value is not None}
     if name == "htetro-ga":
-        return HTetroGA(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate)
+        return HTetroGA(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate, **replan)
     if name == "htetro-ga-paper":
-        return HTetroGA.as_published(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate)
+        return HTetroGA.as_published(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate, **replan)
+    if replan.get("replan_window"):
+        raise ParameterError(f"replan_window applies to the hTetro-GA (htetro-ga, htetro-ga-paper), not to {name!r}")
     operators = dict(
         sampling=sampling,
         crossover=CommandCrossover(prob=crossover_rate),

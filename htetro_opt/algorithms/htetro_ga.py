@@ -11,14 +11,33 @@ never executed), so that the conservative operators keep its end cell: without t
 ``x+`` before the goal with an ``x−`` after it would move where the child stops. ``trim_reached=False``
 keeps the genes whole.
 
-Three additions of ours are on by default, each switchable, and :meth:`HTetroGA.as_published` turns
+Four additions of ours are on by default, each switchable, and :meth:`HTetroGA.as_published` turns
 them all off:
 
 - **repair** (:class:`~htetro_opt.operators.CommandRepair`): every new chromosome has its invalid
   commands replaced by valid ones, so children run their whole genes;
 - **shortcut** (:class:`~htetro_opt.operators.CommandShortcut`): the conservative set also cuts the
   longest loop out of each path;
-- **end-pose niching** of the goal-reachability sort (``niche_size``).
+- **end-pose niching** of the goal-reachability sort (``niche_size``);
+- **windowed exact re-planning** (:class:`~htetro_opt.operators.commands.CommandReplan`,
+  ``replan_window`` and ``replan_members``): each generation, a window of up to W executed commands of
+  the fastest goal-reaching member and of a few random reaching members is replaced by the minimum-time
+  path between the window's end poses; the re-planned chromosomes join the offspring. It generalises
+  the shortcut and is the only operator that makes the 2–4-gene changes a route needs (``sS … sO``
+  where ``y+ … y−`` would do), so the fastest member no longer stays above the exact optimum.
+
+**The loop runs on arrays.** A generation keeps the population as a list of chromosomes beside
+``F`` and the auxiliary columns (``reached``, ``executed``, ``time``, ``end``, ``rank``, ``crowding``):
+the operators run on the list (:mod:`~htetro_opt.operators.commands.batch`: pymoo's ``do()`` without
+a ``Population``), each offspring is simulated once (the simulation that repairs it and finds its
+loop also scores it; :func:`~htetro_opt.operators.commands.shortcut.repair_shortcut_evaluate`), and
+the goal-reachability sort calls pymoo's compiled non-dominated sorting and crowding on ``F``
+(:meth:`~htetro_opt.operators.GoalReachabilitySurvival.sort`). pymoo's ``Population`` is kept at the
+boundary: ``algorithm.pop`` and ``algorithm.opt`` hold the survivors after every generation (each
+survivor's pymoo ``Individual`` made once, when it first survives), so ``minimize``, callbacks,
+terminations and pymoo's ask-and-tell interface (``_infill`` returns the offspring, evaluated;
+``_advance`` takes them) work as with any pymoo algorithm. The offspring are counted in
+``algorithm.evaluator.n_eval`` but do not pass through the evaluator (nor ``algorithm.off``).
 
 Measured on the paper's six maps (benchmarks/README.md), the published algorithm under MODEL.md's
 child termination rarely gets through the spiral's corridor or our random map in 1000 generations,
@@ -29,6 +48,7 @@ from __future__ import annotations
 
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
+from pymoo.core.individual import Individual
 from pymoo.core.population import Population
 
 from htetro_opt._validation import check_bool, check_int, check_probability
@@ -44,8 +64,10 @@ from htetro_opt.operators.commands import (
     RankAndCrowdingTournament,
 )
 from htetro_opt.operators.commands import as_column, sequences
+from htetro_opt.operators.commands.batch import apply_crossover, apply_mutation
 from htetro_opt.operators.commands.duplicates import chromosome_key, first_occurrences
-from htetro_opt.operators.commands.shortcut import repair_and_shortcut
+from htetro_opt.operators.commands.replan import CommandReplan
+from htetro_opt.operators.commands.shortcut import repair_shortcut_evaluate
 
 __all__ = ["HTetroGA", "trim_reached"]
 
@@ -59,6 +81,59 @@ def trim_reached(pop: Population) -> Population:
         if len(X[i, 0]) > executed[i]:
             pop[i].set("X", as_column([X[i, 0][: executed[i]]])[0])
     return pop
+
+
+_COLUMNS = ("reached", "executed", "time", "end")  # what CommandPathProblem.outcomes gives beside F
+_EVALUATED = ("F", "G", "H") + _COLUMNS  # what pymoo's evaluator marks evaluated
+
+
+class _Members:
+    """Individuals as arrays: chromosomes, ``F``, the auxiliary columns and, where one exists, the
+    pymoo ``Individual`` that stands for the row at the boundary."""
+
+    def __init__(self, X: list, F: np.ndarray, columns: dict, individuals: list | None = None) -> None:
+        self.X = X
+        self.F = F
+        self.reached = np.asarray(columns["reached"]).astype(bool)
+        self.executed = np.asarray(columns["executed"]).astype(np.int64)
+        self.time = np.asarray(columns["time"]).astype(float)
+        self.end = np.asarray(columns["end"]).astype(np.int64)
+        self.individuals = individuals if individuals is not None else [None] * len(X)
+
+    @classmethod
+    def of(cls, pop: Population) -> "_Members":
+        """The rows of an evaluated population (its individuals kept)."""
+        F, *columns = pop.get("F", *_COLUMNS)
+        return cls(sequences(pop.get("X")), F.astype(float), dict(zip(_COLUMNS, columns)), list(pop))
+
+    def __len__(self) -> int:
+        return len(self.X)
+
+    def take(self, rows: np.ndarray) -> "_Members":
+        rows = np.asarray(rows, dtype=np.int64)
+        return _Members([self.X[i] for i in rows], self.F[rows],
+                        {key: getattr(self, key)[rows] for key in _COLUMNS}, [self.individuals[i] for i in rows])
+
+    def __add__(self, other: "_Members") -> "_Members":
+        return _Members(self.X + other.X, np.concatenate([self.F, other.F]),
+                        {key: np.concatenate([getattr(self, key), getattr(other, key)]) for key in _COLUMNS},
+                        self.individuals + other.individuals)
+
+    def trim_reached(self) -> None:
+        """Cut every goal-reaching chromosome to its executed prefix, in place (see :func:`trim_reached`)."""
+        for i in np.flatnonzero(self.reached & (np.fromiter(map(len, self.X), np.int64, len(self.X)) > self.executed)):
+            self.X[i] = self.X[i][: self.executed[i]]
+            if self.individuals[i] is not None:
+                self.individuals[i].set("X", as_column([self.X[i]])[0])
+
+    def individual(self, i: int, n_iter: int) -> Individual:
+        """Row i's pymoo Individual, made as pymoo's evaluator would have left it."""
+        if self.individuals[i] is None:
+            ind = Individual(X=as_column([self.X[i]])[0], F=self.F[i].copy(), n_gen=n_iter, n_iter=n_iter,
+                             **{key: getattr(self, key)[i] for key in _COLUMNS})
+            ind.evaluated.update(_EVALUATED)
+            self.individuals[i] = ind
+        return self.individuals[i]
 
 
 class HTetroGA(GeneticAlgorithm):
@@ -84,12 +159,17 @@ class HTetroGA(GeneticAlgorithm):
     niche_size : int
         End-pose niching of the goal-reachability sort (ours; 0 = the paper's sort as written, see
         :class:`~htetro_opt.operators.GoalReachabilitySurvival`).
+    replan_window : int
+        W of the windowed exact re-planning (ours; 0 = off, see
+        :class:`~htetro_opt.operators.commands.CommandReplan`).
+    replan_members : int
+        How many random goal-reaching members are re-planned each generation besides the fastest one.
 
     Raises
     ------
     ParameterError
-        If ``pop_size`` is below 2, ``crossover_rate`` is not a probability, ``niche_size`` is
-        negative or a switch is not a bool.
+        If ``pop_size`` is below 2, ``crossover_rate`` is not a probability, ``niche_size``,
+        ``replan_window`` or ``replan_members`` is negative or a switch is not a bool.
 
     Notes
     -----
@@ -124,6 +204,8 @@ class HTetroGA(GeneticAlgorithm):
         niche_size: int = 3,
         repair: bool = True,
         shortcut: bool = True,
+        replan_window: int = 40,
+        replan_members: int = 3,
         **kwargs,
     ) -> None:
         pop_size = check_int(pop_size, "pop_size", minimum=2)
@@ -146,60 +228,116 @@ class HTetroGA(GeneticAlgorithm):
         self.crossover_rate = crossover_rate
         self.trim_reached = check_bool(trim_reached, "trim_reached")
         self.shortcut = check_bool(shortcut, "shortcut")
+        self.replan_window = check_int(replan_window, "replan_window", minimum=0)
+        self.replan_members = check_int(replan_members, "replan_members", minimum=0)
+        self.replan = CommandReplan(self.replan_window) if self.replan_window else None
 
     @classmethod
     def as_published(cls, pop_size: int = 50, **kwargs) -> "HTetroGA":
-        """The hTetro-GA with none of our additions: no repair, no shortcut, no niching."""
-        return cls(pop_size, repair=False, shortcut=False, niche_size=0, **kwargs)
+        """The hTetro-GA with none of our additions: no repair, no shortcut, no niching, no re-planning.
+
+        A keyword given here switches one back on (e.g. ``replan_window=40``).
+        """
+        options = dict(repair=False, shortcut=False, niche_size=0, replan_window=0)
+        options.update(kwargs)
+        return cls(pop_size, **options)
+
+    # --- pymoo's loop, on arrays ----------------------------------------------------------------
+    def next(self) -> None:
+        """One generation: offspring, evaluation and survival on arrays, then pymoo's bookkeeping
+        (``advance``: the optimum, the termination, the display and the callback)."""
+        if not self.is_initialized:
+            return super().next()  # the initial population: pymoo's sampling, repair and evaluator
+        offspring = self._offspring()
+        if offspring is not None:
+            self._merge(offspring)
+        self.advance()
 
     def _initialize_advance(self, infills=None, **kwargs):
+        members = _Members.of(infills)
         if self.trim_reached:
-            trim_reached(infills)
-        infills = infills[first_occurrences(infills.get("X"))]
-        self.pop = self.survival.do(self.problem, infills, n_survive=len(infills), algorithm=self,
-                                    random_state=self.random_state)
+            members.trim_reached()
+        members = members.take(first_occurrences(members.X))
+        self._survive(members, len(members))
 
     def _infill(self):
-        # Every operator runs through its pymoo ``do()``, so that a user's operator (and its ``prob``)
-        # behaves here as under any pymoo algorithm.
-        problem, pop, rng, mating = self.problem, self.pop, self.random_state, self.mating
-        X = pop.get("X")
-        conservative = self.removal.do(problem, Population.new("X", X), random_state=rng)
-        conservative = self.rearrangement.do(problem, conservative, random_state=rng).get("X")
-
-        crossing = rng.random(len(pop)) < self.crossover_rate
-        n_cross = int(crossing.sum())
-        non_conservative = X[~crossing]
-        if n_cross:
-            matings = mating.selection.do(problem, pop, (n_cross + 1) // 2, n_parents=2,
-                                          to_pop=False, random_state=rng)
-            children = mating.crossover.do(problem, pop, matings, random_state=rng).get("X")
-            non_conservative = np.concatenate([children[:n_cross], non_conservative])
-        non_conservative = mating.mutation.do(problem, Population.new("X", non_conservative),
-                                              random_state=rng).get("X")
-
-        off = np.concatenate([conservative, non_conservative])
-        # Repair and shortcut share one simulation (their pure function), which costs more than all
-        # the other operators together.
-        repair = rng if isinstance(self.repair, CommandRepair) else None
-        seqs = repair_and_shortcut(problem, sequences(off), repair=repair,
-                                   shortcut=len(conservative) if self.shortcut else 0)
-        off = as_column(seqs)
-        seen = {chromosome_key(x) for x in X[:, 0]}
-        off = off[first_occurrences(off, seen)]
-        if len(off) == 0:
-            return None  # nothing new this generation: it counts as one without improvement
-        return Population.new("X", off)
+        """The offspring of a generation as a pymoo ``Population``, already evaluated (pymoo's
+        ask-and-tell interface); None when every one duplicates a member or another offspring."""
+        offspring = self._offspring()
+        if offspring is None:
+            return None
+        return Population([offspring.individual(i, self.n_iter) for i in range(len(offspring))])
 
     def _advance(self, infills=None, **kwargs):
-        if infills is None:
-            return
+        if infills is not None:  # None: nothing new this generation, or ``next`` has already merged it
+            self._merge(_Members.of(infills))
+
+    def _offspring(self) -> _Members | None:
+        """A generation's new chromosomes, evaluated: both offspring sets and the re-planned members,
+        less the duplicates of the members and of each other (None when nothing is left)."""
+        # Each operator runs as its pymoo ``do()`` would (batch.py), so that a user's operator (and
+        # its ``prob``) behaves here as under any pymoo algorithm.
+        problem, rng, mating, parents = self.problem, self.random_state, self.mating, self._members
+        X = parents.X
+        conservative = apply_mutation(self.removal, problem, X, random_state=rng)
+        conservative = apply_mutation(self.rearrangement, problem, conservative, random_state=rng)
+
+        crossing = rng.random(len(X)) < self.crossover_rate
+        n_cross = int(crossing.sum())
+        non_conservative = [X[i] for i in np.flatnonzero(~crossing)]
+        if n_cross:
+            matings = mating.selection.select(self._rank, self._crowding, (n_cross + 1) // 2, 2, random_state=rng)
+            children = apply_crossover(mating.crossover, problem, X, matings, random_state=rng)
+            non_conservative = children[:n_cross] + non_conservative
+        non_conservative = apply_mutation(mating.mutation, problem, non_conservative, random_state=rng)
+
+        # One simulation repairs the offspring, finds the loops the shortcut cuts and scores them.
+        repair = rng if isinstance(self.repair, CommandRepair) else None
+        off, outcomes = repair_shortcut_evaluate(problem, conservative + non_conservative, repair=repair,
+                                                 shortcut=len(conservative) if self.shortcut else 0)
+        n_varied = len(off)
+        if self.replan is not None:
+            members = self._replan_members(rng)
+            if len(members):
+                off = off + apply_mutation(self.replan, problem, [X[i] for i in members], random_state=rng)
+        keep = first_occurrences(off, {chromosome_key(x) for x in X})
+        if not len(keep):
+            return None  # nothing new this generation: it counts as one without improvement
+        self.evaluator.n_eval += len(keep)
+        new = _Members(off[:n_varied], outcomes["F"], outcomes).take(keep[keep < n_varied])
+        replanned = [off[i] for i in keep[keep >= n_varied]]
+        if replanned:  # a few a generation (most re-planned members are unchanged, and dropped above)
+            outcomes = problem.outcomes(problem.simulate(replanned))
+            new = new + _Members(replanned, outcomes["F"], outcomes)
+        return new
+
+    def _replan_members(self, rng: np.random.Generator) -> np.ndarray:
+        """Rows to re-plan: the fastest goal-reaching member (the first of equals) and
+        ``replan_members`` others drawn without replacement among the reaching ones."""
+        reached = np.flatnonzero(self._members.reached)
+        if not len(reached):
+            return reached
+        best = reached[np.argmin(self._members.time[reached])]
+        others = reached[reached != best]
+        drawn = rng.choice(others, size=min(self.replan_members, len(others)), replace=False)
+        return np.r_[best, np.sort(drawn)].astype(np.int64)
+
+    def _merge(self, offspring: _Members) -> None:
+        """The goal-reachability sort of the members and the (trimmed) offspring."""
         if self.trim_reached:
-            trim_reached(infills)
-        merged = Population.merge(self.pop, infills)
-        merged = merged[first_occurrences(merged.get("X"))]
-        self.pop = self.survival.do(self.problem, merged, n_survive=self.pop_size, algorithm=self,
-                                    random_state=self.random_state)
+            offspring.trim_reached()
+        merged = self._members + offspring
+        merged = merged.take(first_occurrences(merged.X))
+        self._survive(merged, self.pop_size)
+
+    def _survive(self, members: _Members, n_survive: int) -> None:
+        rows, self._rank, self._crowding = self.survival.sort(members.F, members.end, n_survive,
+                                                              random_state=self.random_state)
+        self._members = members.take(rows)
+        individuals = [self._members.individual(i, self.n_iter) for i in range(len(rows))]
+        for ind, rank, crowding in zip(individuals, self._rank, self._crowding):
+            ind.data["rank"], ind.data["crowding"] = rank, crowding  # pymoo's Individual.set, less its lookups
+        self.pop = Population(individuals)
 
     def _set_optimum(self):
-        self.opt = self.pop[self.pop.get("rank") == 0]
+        self.opt = self.pop[self._rank == 0]

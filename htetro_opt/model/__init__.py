@@ -1,6 +1,7 @@
 """The one hTetro robot model shared by every method (shared/MODEL.md): geometry, commands, sweeps,
-workspaces, the batch simulator and the coverage motion model. It imports nothing of htetro_opt
-above it (only its errors and option checks)."""
+workspaces, the batch simulator and the coverage motion model, and the continuous workspaces of
+Nazarahari et al. 2019 (:mod:`~htetro_opt.model.continuous`, loaded on first use: it imports
+shapely). It imports nothing of htetro_opt above it (only its errors and option checks)."""
 
 from htetro_opt.model.commands import (
     COMMANDS,
@@ -21,6 +22,9 @@ from htetro_opt.model.simulate import SimulationResult, Simulator, simulate, tra
 from htetro_opt.model.sweeps import SweepTables, sweep_tables
 from htetro_opt.model.workspace import MovingObstacle, Workspace, grid_distance
 
+_CONTINUOUS = ("ContinuousGeometry", "Corners", "as_polygon", "as_robot_radius", "enclosing_radius", "path_length",
+               "path_smoothness", "robot_distance")
+
 __all__ = [
     "COMMANDS", "DIAGONAL_COMMANDS", "SEED000_COMMANDS", "SEED004_COMMANDS", "TOKENS", "Command", "Timing",
     "command_id", "command_set", "format_commands", "parse_commands",
@@ -28,4 +32,13 @@ __all__ = [
     "SimulationResult", "Simulator", "simulate", "transitions_at", "SweepTables", "sweep_tables",
     "MovingObstacle", "Workspace", "grid_distance",
     "CoverageResult", "simulate_coverage",
+    *_CONTINUOUS,
 ]
+
+
+def __getattr__(name: str):
+    if name in _CONTINUOUS:  # shapely loads only when the continuous geometry is used
+        from htetro_opt.model import continuous
+
+        return getattr(continuous, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -30,6 +30,10 @@ coverage heat map "normalized to the range from 0 to 255" and the share of cells
 
 The paper's own figures (Tables 4 and 5) came from a MATLAB Simulink model with its own robot
 dynamics; they are a reference to compare with, not something this model reproduces exactly.
+
+Cheng et al. 2019 (§II-C, §V) measure coverage plans of motion commands the same way:
+:func:`simulate_command_coverage` drives the blocks through the commands themselves (no dwelling,
+no straight-line shortcuts), and :func:`grid_activity` is its eq. 4.
 """
 
 from __future__ import annotations
@@ -41,9 +45,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from htetro_opt._validation import check_int, check_real
-from htetro_opt.errors import ParameterError
+from htetro_opt.errors import ConfigurationError, ParameterError
+from htetro_opt.model.commands import COMMANDS, N_COMMANDS, parse_commands
+from htetro_opt.model.robot import FOOTPRINTS, Pose, as_pose, shape_index
+from htetro_opt.model.simulate import Simulator
+from htetro_opt.model.sweeps import motion_samples
+from htetro_opt.model.workspace import check_workspace
 
-__all__ = ["CoverageResult", "simulate_coverage", "RECOVERED_DENOMINATORS", "MAX_PIXELS"]
+__all__ = ["CoverageResult", "simulate_coverage", "simulate_command_coverage", "grid_activity",
+           "RECOVERED_DENOMINATORS", "MAX_PIXELS"]
 
 RECOVERED_DENOMINATORS = ("all", "free")
 """What :meth:`CoverageResult.recovered` divides by: every cell of the grid (the paper) or the free cells."""
@@ -342,3 +352,203 @@ def simulate_coverage(waypoints, order, *, pixels_per_cell: int = 10, speed: flo
         pixels_per_cell=p,
         cell_size=cell_size,
     )
+
+
+def _command_ids(commands) -> np.ndarray:
+    """Global command ids of tokens (a string or a sequence) or of an integer array."""
+    if isinstance(commands, np.ndarray) and commands.dtype != object and commands.ndim == 1 and \
+            (commands.size == 0 or np.issubdtype(commands.dtype, np.integer)):
+        ids = commands.astype(np.int64)
+        if ids.size and (ids.min() < 0 or ids.max() >= N_COMMANDS):
+            raise ParameterError(f"commands: id {int(ids[(ids < 0) | (ids >= N_COMMANDS)][0])} is not a command id")
+        return ids
+    return parse_commands(commands)
+
+
+def _turn(points: np.ndarray, heading: int) -> np.ndarray:
+    """Points (..., 2) turned by ``heading`` quarter turns counter-clockwise about the origin."""
+    x, y = points[..., 0], points[..., 1]
+    for _ in range(heading % 4):
+        x, y = -y, x
+    return np.stack([x, y], axis=-1)
+
+
+def _stamp(pixel_time: np.ndarray, centres: np.ndarray, angles: np.ndarray, weight: float, p: int) -> None:
+    """Add ``weight`` seconds to every pixel whose centre lies inside one of the turned unit squares
+    ``centres (K, 2)``, ``angles (K,)`` (a pixel under two squares of one instant counts once per square)."""
+    rows, cols = pixel_time.shape
+    reach = 0.5 * math.sqrt(2.0)
+    c0 = max(0, math.floor((centres[:, 0].min() - reach + 0.5) * p))
+    c1 = min(cols, math.ceil((centres[:, 0].max() + reach + 0.5) * p))
+    r0 = max(0, math.floor((centres[:, 1].min() - reach + 0.5) * p))
+    r1 = min(rows, math.ceil((centres[:, 1].max() + reach + 0.5) * p))
+    if c0 >= c1 or r0 >= r1:
+        return
+    xs = (np.arange(c0, c1) + 0.5) / p - 0.5
+    ys = (np.arange(r0, r1) + 0.5) / p - 0.5
+    dx = xs[None, None, :] - centres[:, 0, None, None]
+    dy = ys[None, :, None] - centres[:, 1, None, None]
+    cos, sin = np.cos(angles)[:, None, None], np.sin(angles)[:, None, None]
+    inside = (np.abs(dx * cos + dy * sin) < 0.5) & (np.abs(-dx * sin + dy * cos) < 0.5)
+    pixel_time[r0:r1, c0:c1] += weight * inside.sum(axis=0)
+
+
+def simulate_command_coverage(workspace, start, commands, *, timing=None, dt: float = 0.1,
+                              pixels_per_cell: int = 10) -> CoverageResult:
+    """How long every part of the grid is covered while the robot executes motion commands (Cheng et
+    al. 2019 §V: "decomposes a single grid into 10×10 pixels … the time step is … 0.1").
+
+    The commands are replayed in a :class:`~htetro_opt.model.Simulator` from ``start`` (so they must be
+    valid there). Each command lasts its :class:`~htetro_opt.model.Timing` duration. In a translation
+    (or a diagonal, or ``stop``) every block moves in a straight line, and its pixel times are exact
+    (as in :func:`simulate_coverage`). Every other command (rotations, shapeshifts, Cheng et al.
+    2019's block commands) moves the blocks along the model's own motion
+    (:func:`~htetro_opt.model.sweeps.motion_samples`, turned by the heading), sampled at the midpoints
+    of ``dt``-long steps: at each, a pixel whose centre lies inside a block's turned square gains the
+    step's duration. The robot does not dwell: the run lasts the commands' total duration.
+
+    Parameters
+    ----------
+    workspace : Workspace
+    start : Pose or (x, y, shape, heading)
+    commands : str, sequence of str or ndarray of int
+        Command tokens (``"x+, 3r"``) or global command ids.
+    timing : Timing, optional, keyword-only
+        Durations; one unit a command for Cheng et al. 2019's commands by default.
+    dt : float, keyword-only
+        Sampling step of the turning motions, in seconds (the paper's 0.1).
+    pixels_per_cell : int, keyword-only
+        Raster resolution p (the paper's 10).
+
+    Returns
+    -------
+    CoverageResult
+        ``distance`` and ``block_distance`` are the blocks' path lengths (arcs for turning blocks),
+        ``duration`` the commands' total time, ``free`` the map's free cells.
+
+    Raises
+    ------
+    ParameterError
+        If ``dt`` or ``pixels_per_cell`` is out of range, or the pixel grid would exceed :data:`MAX_PIXELS`.
+    ConfigurationError
+        If the start collides or a command is invalid where it is executed.
+    UnknownCommandError
+        On an unknown token.
+
+    Examples
+    --------
+    >>> from htetro_opt.model import Pose, Workspace
+    >>> ws = Workspace(np.zeros((4, 6), dtype=bool))
+    >>> result = simulate_command_coverage(ws, Pose(1, 1, "O", 0), "x+, x+", pixels_per_cell=4)
+    >>> result.duration, float(result.pixel_time.sum() / 16)  # 4 blocks x 2 s
+    (2.0, 8.0)
+    >>> [float(t) for t in result.cell_time[1, 1:5]]  # left at once, passed over (twice), reached last
+    [0.5, 1.5, 1.5, 0.5]
+    """
+    check_workspace(workspace)
+    p = check_int(pixels_per_cell, "pixels_per_cell", minimum=1)
+    dt = check_real(dt, "dt (seconds)", minimum=0.0, include_minimum=False)
+    start = as_pose(start, "start")
+    ids = _command_ids(commands)
+    h, w = workspace.height, workspace.width
+    if h * w * p * p > MAX_PIXELS:
+        raise ParameterError(f"pixels_per_cell={p} makes a {h * p} x {w * p} pixel grid, more than {MAX_PIXELS} pixels")
+    sim = Simulator(workspace, commands=sorted(set(ids.tolist())) or ["stop"], timing=timing)
+    run = sim.run([ids], start)
+    if not run.valid[0]:
+        k = int(run.first_invalid[0])
+        x, y, s, hd = (int(v) for v in run.poses(0)[-1])
+        raise ConfigurationError(f"command {k + 1} of {len(ids)} ({COMMANDS[int(ids[k])].token}) is invalid from "
+                                 f"({x}, {y}) in state {s} heading {hd}: it sweeps an obstacle or leaves the map")
+    poses = run.poses(0)
+    durations = sim.timing.durations()[ids]
+    pixel_time = np.zeros((h * p, w * p))
+    block_distance = np.zeros(4)
+    for k, c in enumerate(ids.tolist()):
+        x, y, s, hd = (int(v) for v in poses[k])
+        command, duration = COMMANDS[c], float(durations[k])
+        if command.kind in ("translation", "diagonal", "stop"):
+            a = (FOOTPRINTS[s, hd] + (x, y)).astype(float)
+            b = a + np.asarray(command.shift, dtype=float)
+            if duration > 0:
+                for block in range(4):
+                    _sweep(pixel_time, a[block], b[block], duration, p)
+            block_distance += math.hypot(*command.shift)
+            continue
+        centres, angles = motion_samples(s, command)
+        centres = _turn(centres, hd) + (x, y)
+        angles = angles + hd * math.pi / 2
+        block_distance += np.sqrt((np.diff(centres, axis=0) ** 2).sum(-1)).sum(axis=0)
+        if duration <= 0:
+            continue
+        n = max(1, math.ceil(duration / dt - 1e-9))
+        u = (np.arange(n) + 0.5) / n * (len(centres) - 1)
+        i0 = np.minimum(u.astype(int), len(centres) - 2)
+        f = (u - i0)[:, None, None]
+        mid = centres[i0] * (1 - f) + centres[i0 + 1] * f  # (n, 4, 2), dense samples: chords ≈ arcs
+        mid_angles = angles[i0] * (1 - f[..., 0]) + angles[i0 + 1] * f[..., 0]
+        _stamp(pixel_time, mid.reshape(-1, 2), mid_angles.reshape(-1), duration / n, p)
+    cell_time = pixel_time.reshape(h, p, w, p).mean(axis=(1, 3))
+    free = ~workspace.occupancy
+    for array in (pixel_time, cell_time, block_distance):
+        array.setflags(write=False)
+    return CoverageResult(
+        distance=float(block_distance.sum()),
+        block_distance=block_distance,
+        distance_m=float(block_distance.sum()) * workspace.cell_size if workspace.cell_size != 1.0 else None,
+        pixel_time=pixel_time,
+        cell_time=cell_time,
+        free=free,
+        duration=float(durations.sum()),
+        pixels_per_cell=p,
+        cell_size=workspace.cell_size if workspace.cell_size != 1.0 else None,
+    )
+
+
+def grid_activity(workspace, poses) -> np.ndarray:
+    """Cheng et al. 2019's grid activity (eq. 4) after the robot has passed through ``poses``:
+    −1 on an obstacle, 1 on a free cell some pose's footprint covered, 0 elsewhere.
+
+    Parameters
+    ----------
+    workspace : Workspace
+    poses : ndarray of int, shape (n, 4), or sequence of Pose
+        (x, y, state, heading) rows (a :class:`~htetro_opt.model.SimulationResult`'s ``poses(i)``, a
+        coverage plan's ``poses``) or poses; take a prefix for the activity at an earlier time.
+
+    Returns
+    -------
+    ndarray of int8, shape (H, W)
+
+    Raises
+    ------
+    ParameterError
+        If ``poses`` is not an (n, 4) integer array or a pose lies off the map.
+
+    Examples
+    --------
+    >>> from htetro_opt.model import Pose, Workspace
+    >>> occ = np.zeros((3, 4), dtype=bool); occ[2, 3] = True
+    >>> grid_activity(Workspace(occ), [Pose(1, 1, "O", 0)])[::-1].tolist()  # top row first
+    [[0, 0, 0, -1], [0, 1, 1, 0], [0, 1, 1, 0]]
+    """
+    check_workspace(workspace)
+    if not isinstance(poses, np.ndarray):
+        try:
+            poses = np.array([(q.x, q.y, shape_index(q.shape), q.heading) if isinstance(q, Pose) else tuple(q)
+                              for q in poses], dtype=np.int64).reshape(-1, 4)
+        except (TypeError, ValueError) as err:
+            raise ParameterError(f"poses must be (x, y, state, heading) rows or Pose objects, "
+                                 f"got {reprlib.repr(poses)}") from err
+    if poses.ndim != 2 or poses.shape[1] != 4 or (poses.size and not np.issubdtype(poses.dtype, np.integer)):
+        raise ParameterError(f"poses must be an (n, 4) integer array of (x, y, state, heading), got shape {poses.shape}")
+    activity = np.where(workspace.occupancy, -1, 0).astype(np.int8)
+    if len(poses):
+        cells = FOOTPRINTS[poses[:, 2], poses[:, 3]] + poses[:, None, :2]
+        x, y = cells[..., 0].ravel(), cells[..., 1].ravel()
+        if (x < 0).any() or (x >= workspace.width).any() or (y < 0).any() or (y >= workspace.height).any():
+            raise ParameterError("poses: a footprint lies off the map")
+        hit = np.zeros(workspace.occupancy.shape, dtype=bool)
+        hit[y, x] = True
+        activity[hit & ~workspace.occupancy] = 1
+    return activity

@@ -212,9 +212,12 @@ class CommandPathProblem(Problem):
         return reachability, danger
 
     # --- evaluation --------------------------------------------------------------------------
-    def simulate(self, sequences) -> SimulationResult:
-        """Run sequences (global command ids) with the paper's child termination."""
-        return self.simulator.run(sequences, self.start_id, roadmap=[self.goal], t0=self.t0, stop_at_goal=True)
+    def simulate(self, sequences, *, repair: np.random.Generator | None = None) -> SimulationResult:
+        """Run sequences (global command ids) with the paper's child termination; with ``repair`` (a
+        generator), each command that would be invalid is replaced by a valid one as it runs (see
+        :meth:`~htetro_opt.model.Simulator.run`)."""
+        return self.simulator.run(sequences, self.start_id, roadmap=[self.goal], t0=self.t0, stop_at_goal=True,
+                                  repair=repair)
 
     def fitness(self, result: SimulationResult) -> np.ndarray:
         """The four fitnesses (f_gr, f_t, f_sm, f_sf) of a simulated batch, shape (B, 4)."""
@@ -231,14 +234,26 @@ class CommandPathProblem(Problem):
         f_sm = np.where(executed > 1, 1.0 - changes / np.maximum(executed - 1, 1), 1.0)
         danger = self._pose_danger[poses[1:]]  # (L, B): pose after command i
         danger[columns[:, None] >= executed[None, :]] = 0.0
-        f_sf = np.where(executed > 0, 1.0 - danger.sum(axis=0) / (np.maximum(executed, 1) * SAFETY_COEFFICIENT), 1.0)
+        # Summed in command order (cumsum): numpy's sum would add a batch of one pairwise, so a
+        # sequence's f_sf would depend, in its last bit, on the batch it is evaluated in.
+        total = danger.cumsum(axis=0)[-1] if len(danger) else np.zeros(batch)
+        f_sf = np.where(executed > 0, 1.0 - total / (np.maximum(executed, 1) * SAFETY_COEFFICIENT), 1.0)
         return np.column_stack([f_gr, f_t, f_sm, f_sf])
 
+    def outcomes(self, result: SimulationResult) -> dict[str, np.ndarray]:
+        """What evaluation stores of a simulated batch: ``F`` (the negated fitnesses, shape (B, 4)) and
+        the auxiliary columns ``reached``, ``executed``, ``time`` and ``end`` (the final pose id).
+
+        :meth:`_evaluate` is this of :meth:`simulate`; the hTetro-GA calls it on the simulation that
+        also repairs its offspring, so that each is simulated once.
+        """
+        return {
+            "F": -self.fitness(result),
+            "reached": result.reached,
+            "executed": result.executed,
+            "time": result.time,
+            "end": result.keys[result.executed, np.arange(len(result))] // self.simulator.n_columns,
+        }
+
     def _evaluate(self, X, out, *args, **kwargs):
-        sequences = [x[0] for x in X]
-        result = self.simulate(sequences)
-        out["F"] = -self.fitness(result)
-        out["reached"] = result.reached
-        out["executed"] = result.executed
-        out["time"] = result.time
-        out["end"] = result.keys[result.executed, np.arange(len(result))] // self.simulator.n_columns
+        out.update(self.outcomes(self.simulate([x[0] for x in X])))

@@ -12,17 +12,24 @@
 
 :class:`SequencingInstance` holds one instance for every sequencing method (cost matrix, block cells, start);
 :class:`SequencingProblem` poses it as a pymoo permutation problem.
+
+Beyond the paper (a choice of ours, for inputs users have): an instance may come from any square
+finite matrix (:meth:`SequencingInstance.from_matrix`, no tile geometry, asymmetric allowed), be a
+closed tour (``closed=True``: the order returns to its first waypoint) or an open path with a fixed
+last waypoint (``end``). :func:`reduce_to_open_path` turns such an instance into the paper's open
+path with a fixed or free start, so that every method built for the paper's problem solves it too.
 """
 
 from __future__ import annotations
 
 import reprlib
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
-from htetro_opt._validation import check_int
+from htetro_opt._validation import check_bool, check_int
 from htetro_opt.errors import ConfigurationError, ParameterError, PlanningError
 from htetro_opt.model.tiles import scan_key, tile_poses
 from htetro_opt.scenarios.tileset import Tileset, check_tileset
@@ -34,7 +41,10 @@ __all__ = [
     "cost_matrix",
     "path_cost",
     "SequencingInstance",
+    "OpenPathReduction",
     "check_instance",
+    "check_matrix",
+    "reduce_to_open_path",
 ]
 
 DEFAULT_BLOCK_WEIGHTS = (0.25, 0.25, 0.25, 0.25)
@@ -196,6 +206,44 @@ def block_locations(occupancy, tiles, *, weights=DEFAULT_BLOCK_WEIGHTS, cell_siz
     return Tileset.from_poses(occupancy, poses, cell_size=cell_size, name=name)
 
 
+def check_matrix(matrix, name: str = "matrix") -> np.ndarray:
+    """A square, non-empty, finite matrix of numbers as a float array (a copy), validated.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``name`` and what is wrong: not numbers, ragged rows (which row), not square, empty,
+        or non-finite entries (how many, and the first).
+
+    Examples
+    --------
+    >>> check_matrix([[0, 1], [2, 0]]).tolist()
+    [[0.0, 1.0], [2.0, 0.0]]
+    >>> check_matrix([[0, 1, 2], [1, 0]])
+    Traceback (most recent call last):
+    ...
+    htetro_opt.errors.ParameterError: matrix must be square: row 1 has 2 entries, row 0 has 3
+    """
+    if isinstance(matrix, (list, tuple)):
+        lengths = [len(row) if isinstance(row, (list, tuple, np.ndarray)) else None for row in matrix]
+        for i, length in enumerate(lengths):
+            if length is not None and lengths[0] is not None and length != lengths[0]:
+                raise ParameterError(f"{name} must be square: row {i} has {length} entries, row 0 has {lengths[0]}")
+    try:
+        m = np.array(matrix, dtype=float)
+    except (TypeError, ValueError) as err:
+        raise ParameterError(f"{name} must be a square matrix of numbers, got {type(matrix).__name__} "
+                             f"{reprlib.repr(matrix)}") from err
+    if m.ndim != 2 or m.shape[0] != m.shape[1] or m.shape[0] == 0:
+        raise ParameterError(f"{name} must be a non-empty square matrix, got shape {m.shape}")
+    bad = ~np.isfinite(m)
+    if bad.any():
+        i, j = (int(v) for v in np.argwhere(bad)[0])
+        raise ParameterError(f"{name} must be finite: {int(bad.sum())} entries are not, the first at "
+                             f"[{i}, {j}] = {m[i, j]}")
+    return m
+
+
 @dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
 class SequencingInstance:
     """One waypoint-sequencing instance, shared by every sequencing method.
@@ -203,29 +251,41 @@ class SequencingInstance:
     Parameters
     ----------
     cost : ndarray of float, shape (n, n)
-        Eq.-2 cost between waypoints (symmetric, zero diagonal).
-    blocks : ndarray of int, shape (n, 4, 2)
-        Cells of blocks a–d at each waypoint (the pattern baselines scan block b's cell).
+        Cost of moving from waypoint i to waypoint j: eq. 2 for a tileset (symmetric, zero diagonal),
+        any finite numbers for :meth:`from_matrix` (the diagonal is never used).
+    blocks : ndarray of int, shape (n, 4, 2), or None
+        Cells of blocks a–d at each waypoint (the pattern baselines scan block b's cell); None for an
+        instance without tile geometry (:meth:`from_matrix`), which the pattern baselines refuse.
     start : int or None
-        Index (0…n−1) of the waypoint every path starts from, or None for a free start.
+        Index (0…n−1) of the waypoint every order begins at, or None for a free start (for a closed
+        tour: where the listed order begins; its cost does not depend on it).
     ids : tuple of int
-        Tile labels, for reporting orders.
+        Tile labels, for reporting orders (default 1…n).
     shape : (int, int)
         The grid's (H, W).
+    closed : bool
+        True: a closed tour, priced with the leg from the last waypoint back to the first. False
+        (the paper's problem): an open path.
+    end : int or None
+        Open paths only: the index of the waypoint every order ends at, or None for a free end.
 
     Raises
     ------
     PlanningError
         If the cost matrix is not square, non-empty and finite.
     ParameterError
-        If ``start`` is not None or a waypoint index, or an argument has the wrong type or size.
+        If ``start`` or ``end`` is not None or a waypoint index, ``end`` is given for a closed tour or
+        equals ``start`` on an open path of more than one waypoint, or an argument has the wrong type
+        or size.
     """
 
     cost: np.ndarray
-    blocks: np.ndarray
+    blocks: np.ndarray | None = None
     start: int | None = 0
     ids: tuple[int, ...] = ()
     shape: tuple[int, int] = (0, 0)
+    closed: bool = False
+    end: int | None = None
 
     def __post_init__(self) -> None:
         try:
@@ -237,10 +297,21 @@ class SequencingInstance:
         if cost.shape != (n, n) or n == 0 or not np.isfinite(cost).all():
             raise PlanningError(f"the cost matrix must be square, non-empty and finite, got shape {cost.shape}")
         start = check_int(self.start, "start", minimum=0, maximum=n - 1, allow_none=True)
-        blocks = _block_cells(self.blocks)
-        if len(blocks) != n:
-            raise ParameterError(f"blocks must hold the cells of the {n} waypoints of the cost matrix, got {len(blocks)}")
-        blocks = blocks.astype(np.int64)
+        closed = check_bool(self.closed, "closed")
+        end = check_int(self.end, "end", minimum=0, maximum=n - 1, allow_none=True)
+        if closed and end is not None:
+            raise ParameterError(f"end={end} applies to open paths only: a closed tour returns to its first waypoint")
+        if end is not None and end == start and n > 1:
+            raise ParameterError(f"start and end are both waypoint {end}: an open path of {n} waypoints "
+                                 "cannot begin and end at one waypoint (use closed=True for a tour)")
+        blocks = None
+        if self.blocks is not None:
+            blocks = _block_cells(self.blocks)
+            if len(blocks) != n:
+                raise ParameterError(f"blocks must hold the cells of the {n} waypoints of the cost matrix, "
+                                     f"got {len(blocks)}")
+            blocks = blocks.astype(np.int64)
+            blocks.setflags(write=False)
         try:
             ids = tuple(check_int(i, "tile id") for i in self.ids) or tuple(range(1, n + 1))
             shape = tuple(check_int(v, "grid shape (H, W)", minimum=0) for v in self.shape)
@@ -250,13 +321,14 @@ class SequencingInstance:
         if len(ids) != n or len(shape) != 2:
             raise ParameterError(f"need one tile id per waypoint ({n}) and a grid shape (H, W), got {len(ids)} ids "
                                  f"and shape {shape}")
-        for array in (cost, blocks):
-            array.setflags(write=False)
+        cost.setflags(write=False)
         object.__setattr__(self, "cost", cost)
         object.__setattr__(self, "blocks", blocks)
         object.__setattr__(self, "ids", ids)
         object.__setattr__(self, "start", start)
         object.__setattr__(self, "shape", shape)
+        object.__setattr__(self, "closed", closed)
+        object.__setattr__(self, "end", end)
 
     @classmethod
     def from_tileset(cls, tileset: Tileset, *, start: int | None = 1,
@@ -291,21 +363,75 @@ class SequencingInstance:
         return cls(cost_matrix(tileset.blocks, weights), tileset.blocks, index, tileset.ids,
                    tileset.occupancy.shape)
 
+    @classmethod
+    def from_matrix(cls, matrix, *, closed: bool = False, start: int | None = None, end: int | None = None,
+                    ids=None) -> "SequencingInstance":
+        """The instance of a plain cost matrix: no tile geometry, any square finite matrix.
+
+        ``matrix[i][j]`` is the cost of moving from waypoint i to waypoint j; the diagonal is never
+        used. An asymmetric matrix is accepted here; the methods that assume symmetric costs
+        (``local``, ``ga``, ``fast-tsp``) refuse it, and the pattern baselines (``zigzag``,
+        ``spiral``), which scan tile positions, refuse any instance without geometry.
+
+        Parameters
+        ----------
+        matrix : array_like, shape (n, n)
+            Finite numbers (a list of lists or an array).
+        closed : bool, keyword-only
+            A closed tour (True) or an open path (False, the default).
+        start, end : int or None, keyword-only
+            Waypoint indices (0…n−1) the order begins / ends at; None (the default): free. ``end``
+            applies to open paths only.
+        ids : sequence of int, optional, keyword-only
+            Labels of the waypoints in reports (default 1…n).
+
+        Raises
+        ------
+        ParameterError
+            On a ragged, non-square, empty or non-finite matrix, a bad ``start`` or ``end``, ``end``
+            with ``closed=True``, or ``start == end`` on an open path of more than one waypoint.
+
+        Examples
+        --------
+        >>> inst = SequencingInstance.from_matrix([[0, 1, 9], [1, 0, 2], [9, 2, 0]], closed=True)
+        >>> inst.path_cost([0, 1, 2]), inst.blocks is None, inst.symmetric
+        (12.0, True, True)
+        >>> SequencingInstance.from_matrix([[0, 1], [5, 0]], start=0, end=1).path_cost([0, 1])
+        1.0
+        """
+        m = check_matrix(matrix)
+        return cls(m, None, start, () if ids is None else ids, (0, 0), closed, end)
+
     @property
     def n(self) -> int:
         return len(self.cost)
 
+    @cached_property
+    def symmetric(self) -> bool:
+        """Whether ``cost`` is symmetric (to 1e-9 relative): the methods that assume it check this."""
+        return bool(np.allclose(self.cost, self.cost.T, rtol=1e-9, atol=1e-12))
+
+    @property
+    def has_geometry(self) -> bool:
+        """Whether the waypoints have block cells (a tileset's instance) for the pattern baselines."""
+        return self.blocks is not None
+
     def path_cost(self, order) -> float:
-        """Summed cost of an order (waypoint indices)."""
-        return path_cost(self.cost, order)
+        """Summed cost of an order (waypoint indices); a closed tour adds the leg back to its first."""
+        total = path_cost(self.cost, order)
+        if self.closed and np.size(order) > 1:
+            order = np.asarray(order, dtype=np.int64)
+            total += float(self.cost[order[-1], order[0]])
+        return total
 
     def check_order(self, order) -> np.ndarray:
-        """The order as an int array, checked to visit every waypoint once from the start.
+        """The order as an int array, checked to visit every waypoint once from the start (to the end).
 
         Raises
         ------
         PlanningError
-            If it is not a permutation of 0…n−1 or does not begin at the start waypoint.
+            If it is not a permutation of 0…n−1, does not begin at the start waypoint or does not
+            end at the end waypoint.
         """
         try:
             array = np.asarray(order)
@@ -319,11 +445,96 @@ class SequencingInstance:
             raise PlanningError(f"an order must visit each of the {self.n} waypoints exactly once")
         if self.start is not None and order[0] != self.start:
             raise PlanningError(f"an order must begin at tile {self.ids[self.start]}, not tile {self.ids[order[0]]}")
+        if self.end is not None and order[-1] != self.end:
+            raise PlanningError(f"an order must end at tile {self.ids[self.end]}, not tile {self.ids[order[-1]]}")
         return order
 
     def tile_order(self, order) -> list[int]:
         """Tile labels of an order of waypoint indices."""
         return [self.ids[i] for i in np.asarray(order, dtype=np.int64).tolist()]
+
+
+@dataclass(frozen=True, eq=False)
+class OpenPathReduction:
+    """An instance restated as the paper's open path (free end), and the way back.
+
+    ``instance`` is an open path with a free end and the original's start (a closed tour: its
+    start, or waypoint 0); ``decode(order)`` turns an order of it into a valid order of the original
+    (dropping the closing copy, moving the end waypoint last); every order of the original that
+    ``decode`` returns unchanged costs ``offset`` more in ``instance`` than in the original.
+    """
+
+    instance: SequencingInstance
+    decode: Callable[[np.ndarray], np.ndarray]
+    offset: float
+
+
+def reduce_to_open_path(instance: SequencingInstance) -> OpenPathReduction:
+    """Restate a closed tour or a fixed-end path as an open path with a free end (a choice of ours).
+
+    - **Closed tour** of ``n`` waypoints: an open path over ``n + 1``, the last a copy of the first
+      waypoint ``s`` (the start, or 0 when free) with ``s``'s costs, from ``s`` to the copy. Its
+      cost is the tour's.
+    - **Fixed end** ``e`` (also the copy of a closed tour): a penalty ``K = 5·max|C|`` (1 when every
+      cost is 0) makes any other last waypoint dearer than any path ending at ``e``. A symmetric
+      matrix gets ``K`` on every leg touching ``e`` (so it stays symmetric, for the methods that
+      need it; an optimal path then touches ``e`` once, at an end, and the offset is ``K``; with a
+      free start a path beginning at ``e`` is reversed); an asymmetric one gets ``K`` on the legs
+      leaving ``e`` (offset 0). Moving ``e`` to the end of a path changes its other legs by at most
+      ``4·max|C|`` and saves at least ``K``, so an optimal order of the reduction is one of the
+      original, and a lower bound on it, less the offset, bounds the original's optimum.
+
+    A heuristic's order that misses the end is still decoded to a valid order (the end waypoint
+    moved last); its cost is then the original's, re-priced, not the reduction's.
+
+    Examples
+    --------
+    >>> inst = SequencingInstance.from_matrix([[0, 1, 4], [1, 0, 2], [4, 2, 0]], closed=True, start=1)
+    >>> red = reduce_to_open_path(inst)
+    >>> red.instance.n, red.instance.start, red.instance.end, red.decode([1, 0, 2, 3]).tolist()
+    (4, 1, None, [1, 0, 2])
+    >>> inst.path_cost([1, 0, 2]), red.instance.path_cost([1, 0, 2, 3]) - red.offset
+    (7.0, 7.0)
+    """
+    instance = check_instance(instance)
+    n, C, blocks = instance.n, instance.cost, instance.blocks
+    start, end, ids = instance.start, instance.end, instance.ids
+    copied = instance.closed and n > 1
+    if copied:
+        s = 0 if start is None else start
+        D = np.zeros((n + 1, n + 1))
+        D[:n, :n] = C
+        D[:n, n] = C[:, s]
+        D[n, :n] = C[s, :]
+        D[s, n] = D[n, s] = 0.0
+        C, start, end, ids = D, s, n, ids + (max(ids) + 1,)
+        if blocks is not None:
+            blocks = np.concatenate([blocks, blocks[s:s + 1]])
+    offset = 0.0
+    if end is not None and len(C) > 1:
+        top = float(np.abs(C[~np.eye(len(C), dtype=bool)]).max())
+        penalty = 5.0 * top if top > 0 else 1.0
+        symmetric = bool(np.allclose(C, C.T, rtol=1e-9, atol=1e-12))
+        C = np.array(C, dtype=float)
+        C[end, :] += penalty
+        if symmetric:
+            C[:, end] += penalty
+            offset = penalty
+    reduced = SequencingInstance(C, blocks, start, ids, instance.shape)
+    fixed_end = end
+
+    def decode(order) -> np.ndarray:
+        order = np.asarray(order, dtype=np.int64).reshape(-1)
+        if fixed_end is not None and len(order) > 1 and order[-1] != fixed_end:
+            if order[0] == fixed_end and start is None and offset:
+                order = order[::-1]  # symmetric: the reversed path costs the same
+            else:
+                order = np.concatenate([order[order != fixed_end], [fixed_end]])
+        if copied:
+            order = order[order != n]
+        return order.copy()
+
+    return OpenPathReduction(reduced, decode, offset)
 
 
 def check_instance(instance, name: str = "instance") -> SequencingInstance:

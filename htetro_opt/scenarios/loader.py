@@ -26,7 +26,8 @@ A grid scenario::
 
 A continuous scenario (Nazarahari et al. 2019) has ``width``, ``height``, ``obstacles`` (rectangles
 ``[xmin, ymin, xmax, ymax]`` or polygons ``[[x, y], ...]``), ``robot_radius`` and ``[[robots]]`` with
-``start`` and ``goal`` points.
+``start`` and ``goal`` points. Obstacles must be simple polygons; starts and goals must be
+feasible (:mod:`htetro_opt.model.continuous`), and no two robots' starts (nor goals) closer than 2 r.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from __future__ import annotations
 import reprlib
 import tomllib
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -81,7 +83,19 @@ class Scenario:
 
 @dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
 class ContinuousScenario:
-    """A continuous W × H rectangle with polygon obstacles and point robots (Nazarahari et al. 2019)."""
+    """A continuous W × H rectangle with polygon obstacles and disc robots (Nazarahari et al. 2019).
+
+    ``obstacles`` are (n, 2) vertex arrays, ``starts`` and ``goals`` (k, 2) arrays, one row per
+    robot. :attr:`geometry` answers feasibility and clearance questions
+    (:class:`~htetro_opt.model.continuous.ContinuousGeometry`, built on first use).
+
+    Examples
+    --------
+    >>> from htetro_opt.scenarios import load_scenario
+    >>> sc = ContinuousScenario.from_grid(load_scenario("three_slit"), robot_radius="O")
+    >>> sc.width, sc.n_robots, round(sc.robot_radius, 4), sc.geometry.points_feasible(sc.starts).tolist()
+    (24.0, 1, 1.4142, [True])
+    """
 
     name: str
     source: str
@@ -93,6 +107,84 @@ class ContinuousScenario:
     goals: np.ndarray
     description: str = ""
     path: Path | None = None
+
+    @property
+    def n_robots(self) -> int:
+        return len(self.starts)
+
+    @cached_property
+    def geometry(self):
+        """The workspace's :class:`~htetro_opt.model.continuous.ContinuousGeometry` (shapely objects
+        built once per scenario)."""
+        from htetro_opt.model.continuous import ContinuousGeometry  # shapely loads for continuous work only
+
+        return ContinuousGeometry(self.width, self.height, self.obstacles, robot_radius=self.robot_radius)
+
+    def with_robot_radius(self, robot_radius) -> ContinuousScenario:
+        """The same scenario for robots of another radius (a number ≥ 0 or a morphology letter: the
+        disc enclosing that hTetro footprint), checked as a file is.
+
+        Raises
+        ------
+        ParameterError
+            If the radius is neither a number ≥ 0 nor a shape letter.
+        ConfigurationError
+            If a start or goal then collides, leaves the workspace, or two robots overlap.
+        """
+        from htetro_opt.model.continuous import as_robot_radius
+
+        radius = as_robot_radius(robot_radius)
+        geometry = _continuous_geometry(self.width, self.height, self.obstacles, radius, self.name)
+        _check_robots(geometry, self.starts, self.goals, self.name)
+        return ContinuousScenario(self.name, self.source, self.width, self.height, self.obstacles, radius,
+                                  self.starts, self.goals, self.description, self.path)
+
+    @classmethod
+    def from_grid(cls, scenario: Scenario, *, robot_radius=0.0) -> ContinuousScenario:
+        """A grid scenario as a continuous one, so that its maps can be compared: each obstacle cell
+        (x, y) is the unit square [x, x + 1] × [y, y + 1] (a row's runs of cells merged into
+        rectangles), the roadmap's first and last configurations give the start and goal, at their
+        B2 cell's centre. Units are cells.
+
+        Parameters
+        ----------
+        scenario : Scenario
+            A grid scenario with a roadmap.
+        robot_radius : float or str, keyword-only
+            A number ≥ 0 or a morphology letter (the disc enclosing that footprint, e.g. ``"O"``).
+
+        Raises
+        ------
+        ScenarioError
+            If ``scenario`` is not a grid scenario or has no start and goal.
+        ParameterError
+            On a bad radius.
+        ConfigurationError
+            If the start or goal collides at that radius.
+        """
+        from htetro_opt.model.continuous import as_robot_radius
+
+        if not isinstance(scenario, Scenario):
+            raise ScenarioError(f"scenario must be a grid Scenario, got {type(scenario).__name__}")
+        if scenario.goal is None:
+            raise ScenarioError(f"scenario {scenario.name!r} has no start and goal (its roadmap has "
+                                f"{len(scenario.roadmap)} configuration(s))")
+        radius = as_robot_radius(robot_radius)
+        occ = scenario.workspace.occupancy
+        obstacles = []
+        for y, row in enumerate(occ):
+            padded = np.concatenate([[False], row, [False]]).astype(np.int8)
+            edges = np.flatnonzero(np.diff(padded))
+            for x0, x1 in zip(edges[::2].tolist(), edges[1::2].tolist()):
+                obstacles.append(np.array([[x0, y], [x1, y], [x1, y + 1], [x0, y + 1]], dtype=float))
+        starts = np.array([[scenario.start.x + 0.5, scenario.start.y + 0.5]])
+        goals = np.array([[scenario.goal.x + 0.5, scenario.goal.y + 0.5]])
+        width, height = float(occ.shape[1]), float(occ.shape[0])
+        geometry = _continuous_geometry(width, height, obstacles, radius, scenario.name)
+        _check_robots(geometry, starts, goals, scenario.name)
+        source = f"{scenario.source} (as a continuous workspace)" if scenario.source else "a grid scenario"
+        return cls(scenario.name, source, width, height, tuple(obstacles), radius, starts, goals,
+                   scenario.description, scenario.path)
 
 
 def parse_grid(text: str, *, where: str = "grid") -> np.ndarray:
@@ -192,20 +284,6 @@ def _number(table: dict, key: str, where: str, default=None, **bounds) -> float:
         return check_real(value, f"{where}: {key!r}", **bounds)
     except ParameterError as err:  # a file's content: the loader's error
         raise ScenarioError(str(err)) from err
-
-
-def _point_in_obstacle(point: np.ndarray, polygon: np.ndarray, radius: float) -> bool:
-    """Whether a point lies inside a polygon or within ``radius`` of its boundary."""
-    x, y = point
-    inside = False
-    for (x0, y0), (x1, y1) in zip(polygon, np.roll(polygon, -1, axis=0)):
-        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
-            inside = not inside
-        edge = np.array([x1 - x0, y1 - y0])
-        t = np.clip(np.dot(point - (x0, y0), edge) / max(np.dot(edge, edge), 1e-300), 0.0, 1.0)
-        if np.hypot(*(point - (np.array([x0, y0]) + t * edge))) < radius:
-            return True
-    return inside
 
 
 def _cells(value: Any, where: str) -> np.ndarray:
@@ -341,37 +419,62 @@ def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = N
     return Scenario(name, source, workspace, tuple(roadmap), description, hidden, base)
 
 
+def _continuous_geometry(width, height, obstacles, radius, where):
+    from htetro_opt.model.continuous import ContinuousGeometry  # shapely loads for continuous work only
+
+    try:
+        return ContinuousGeometry(width, height, obstacles, robot_radius=radius)
+    except ParameterError as err:
+        raise ScenarioError(f"{where}: {err}") from err
+
+
+def _check_robots(geometry, starts: np.ndarray, goals: np.ndarray, where: str) -> None:
+    """Starts and goals inside F (the shrunk box, clear of the C-obstacles), no two robots' starts
+    (nor goals) closer than 2 r (nor equal)."""
+    r = geometry.robot_radius
+    for key, points in (("start", starts), ("goal", goals)):
+        feasible = geometry.points_feasible(points)
+        for i in np.flatnonzero(~feasible).tolist():
+            at, point = f"{where}: robots[{i + 1}]", points[i].tolist()
+            hit = geometry.colliding_obstacle(points[i])
+            if hit is None:
+                raise ConfigurationError(f"{at}: {key} {point} (radius {r:g}) lies outside the "
+                                         f"{geometry.width:g} x {geometry.height:g} workspace")
+            raise ConfigurationError(f"{at}: {key} {point} collides with obstacles[{hit + 1}] (radius {r:g})")
+    for key, points in (("start", starts), ("goal", goals)):
+        if len(points) > 1:
+            gaps = np.hypot(*(points[:, None] - points[None]).transpose(2, 0, 1))
+            close = np.argwhere(np.triu((gaps < 2 * r) | (gaps == 0), 1))
+            if len(close):
+                i, j = close[0].tolist()
+                raise ConfigurationError(f"{where}: robots[{i + 1}] and robots[{j + 1}] overlap: their {key}s "
+                                         f"{points[i].tolist()} and {points[j].tolist()} are {gaps[i, j]:g} "
+                                         f"apart, less than 2 r = {2 * r:g}")
+
+
 def _parse_continuous(data: dict, *, where: str, base: Path | None, default_name: str | None = None) -> ContinuousScenario:
+    from htetro_opt.model.continuous import as_polygon
+
     name, source, description = _header(data, _CONTINUOUS_KEYS, where, default_name)
     width = _number(data, "width", where, minimum=0.0, include_minimum=False)
     height = _number(data, "height", where, minimum=0.0, include_minimum=False)
     radius = _number(data, "robot_radius", where, default=0.0, minimum=0.0)
     obstacles = []
     for i, item in enumerate(_array(data, "obstacles", where), start=1):
-        at = f"{where}: obstacles[{i}]"
         try:
-            arr = np.array(item, dtype=float)
-        except (TypeError, ValueError) as err:
-            raise ScenarioError(f"{at}: expected [xmin, ymin, xmax, ymax] or a list of [x, y] points") from err
-        if arr.shape == (4,):
-            x0, y0, x1, y1 = arr
-            if not (x0 < x1 and y0 < y1):
-                raise ScenarioError(f"{at}: rectangle needs xmin < xmax and ymin < ymax")
-            arr = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
-        elif arr.ndim != 2 or arr.shape[1] != 2 or len(arr) < 3:
-            raise ScenarioError(f"{at}: expected [xmin, ymin, xmax, ymax] or at least 3 [x, y] points")
-        if not np.isfinite(arr).all():
-            raise ScenarioError(f"{at}: coordinates must be finite numbers")
-        obstacles.append(arr)
+            obstacles.append(as_polygon(item, f"{where}: obstacles[{i}]"))
+        except ParameterError as err:  # a file's content: the loader's error
+            raise ScenarioError(str(err)) from err
+    geometry = _continuous_geometry(width, height, obstacles, radius, where)
     robots = _array(data, "robots", where, tables=True)
     if not robots:
         raise ScenarioError(f"{where}: 'robots' needs at least one robot ([[robots]] with start and goal)")
-    starts, goals = [], []
+    points = {"start": [], "goal": []}
     for i, robot in enumerate(robots, start=1):
         at = f"{where}: robots[{i}]"
         if not isinstance(robot, dict) or set(robot) - {"start", "goal"}:
             raise ScenarioError(f"{at}: expected a table with 'start' and 'goal'")
-        for key, out in (("start", starts), ("goal", goals)):
+        for key, out in points.items():
             value = _require(robot, key, list, at)
             try:
                 point = np.array(value, dtype=float)
@@ -379,17 +482,13 @@ def _parse_continuous(data: dict, *, where: str, base: Path | None, default_name
                 raise ScenarioError(f"{at}: {key} must be [x, y] numbers, got {value!r}") from err
             if point.shape != (2,) or not np.isfinite(point).all():
                 raise ScenarioError(f"{at}: {key} must be [x, y] numbers, got {value!r}")
-            if not (radius <= point[0] <= width - radius and radius <= point[1] <= height - radius):
-                raise ConfigurationError(
-                    f"{at}: {key} {point.tolist()} (radius {radius:g}) lies outside the {width:g} x {height:g} workspace"
-                )
-            for j, polygon in enumerate(obstacles, start=1):
-                if _point_in_obstacle(point, polygon, radius):
-                    raise ConfigurationError(f"{at}: {key} {point.tolist()} collides with obstacles[{j}] (radius {radius:g})")
             out.append(point)
-    return ContinuousScenario(
-        name, source, width, height, tuple(obstacles), radius, np.array(starts), np.array(goals), description, base,
-    )
+    starts, goals = np.array(points["start"]), np.array(points["goal"])
+    _check_robots(geometry, starts, goals, where)
+    scenario = ContinuousScenario(name, source, width, height, tuple(obstacles), radius, starts, goals,
+                                  description, base)
+    scenario.__dict__["geometry"] = geometry  # built for the checks: the cached property's value
+    return scenario
 
 
 def load_scenario_file(path: str | Path) -> Scenario | ContinuousScenario:

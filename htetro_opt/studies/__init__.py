@@ -2,8 +2,11 @@
 
 - :mod:`htetro_opt.studies.table4`: Cheng et al. 2020's Table 4 (hTetro-GA over six environments
   and three population sizes), plus the gap of every GA plan to the exact minimum-time plan;
-- :mod:`htetro_opt.studies.seed003`: Le et al. 2018's Tables 1–5 (tiling + waypoint sequencing),
+- :mod:`htetro_opt.studies.le2018`: Le et al. 2018's Tables 1–5 (tiling + waypoint sequencing),
   with every method's gap to the exact optimum;
+- :mod:`htetro_opt.studies.do2021`: Do et al. 2021's Tables 6–8 and Fig. 13 (the heat-conduction
+  planner under four weightings, beside the hTetro-GA, the exact optimum and O-shape-only A* and
+  Dijkstra; replanning with hidden obstacles), every plan scored by the paper's costs;
 - :mod:`htetro_opt.studies.metrics`: mean ± standard deviation aggregation over trial records.
 
 Studies may use the model, problems, solvers and scenarios, never the plotting or the command line.

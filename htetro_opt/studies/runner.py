@@ -23,11 +23,16 @@ Top-level keys: ``name`` (default: the file's stem; it names the results files),
 ``seeds`` (N for 0 … N−1, or a list), ``metrics`` (optional metrics, :data:`METRICS`) and the
 ``[[methods]]``. A method entry holds ``method``, an optional ``label`` (the name of its rows), the
 verb's options, and ``[methods.per_scenario.<scenario>]`` tables of options for one scenario
-(e.g. Table 4's ``max_length = 200`` on the spiral map). The options:
+(e.g. Table 4's ``max_length = 200`` on the spiral map). An entry's own ``scenarios`` (a list of
+some of the study's scenarios) runs the method on those only (Do et al. 2021's Table 7 runs the GA
+on the first four maps of its Table 6). The options:
 
 - ``plan``: method ``dijkstra`` (alias ``exact``), ``astar``, ``htetro-ga``, ``htetro-ga-paper``,
-  ``nsga2``, ``nsga3``, ``smsemoa``, ``agemoea``; ``clearance``; ``diagonals`` (the exact methods);
-  ``pop_size``, ``max_gen``, ``patience``, ``max_length`` (the GAs);
+  ``nsga2``, ``nsga3``, ``smsemoa``, ``agemoea``, ``heat``; ``clearance``; ``diagonals`` (the exact
+  methods); ``pop_size``, ``max_gen``, ``patience``, ``max_length`` (the GAs); ``weights``
+  (``[w_t, w_sm, w_sf]`` or ``"w_t,w_sm,w_sf"``), ``t_max``, ``element`` (``"q1"`` or ``"p0"``),
+  ``monotone``, ``band`` (``"auto"``, ``"full"`` or a radius in cells) (the heat planner of
+  Do et al. 2021, which always plans with the diagonals);
 - ``tile``: method ``backtracking`` or ``cpsat``; ``shapes`` (e.g. ``"TZ"``), ``overlap``,
   ``shuffle`` (then the trials are seeded), ``time_limit`` (default: none);
 - ``sequence``: any sequencing method (``auto``, ``exact``, ``ortools``, ``local``, ``ga``, …);
@@ -41,11 +46,13 @@ key).
 A **trial** (:func:`run_trial`) is one method on one scenario with one seed: a pure, module-level
 function whose record is a flat, JSON-ready dict of its inputs, metrics, runtime, solution (the
 commands or order, comma-separated), the package version and ``key``, a hash of its inputs. A method
-whose result does not depend on a seed (the exact planners, a tiling without ``shuffle``, the
-deterministic sequencing methods) runs once per scenario, its record's ``seed`` None. The gap to the
-exact optimum (metric ``"gap"``) comes from one **reference** trial per scenario and run
-(:func:`run_reference`: Dijkstra for ``plan``, the CP-SAT optimum for ``sequence``), recorded in the
-results file like the others.
+whose result does not depend on a seed (the exact planners, the heat planner, a tiling without
+``shuffle``, the deterministic sequencing methods) runs once per scenario, its record's ``seed`` None.
+The gap to the exact optimum (metric ``"gap"``) comes from one **reference** trial per scenario and
+run (:func:`run_reference`: Dijkstra for ``plan``, the CP-SAT optimum for ``sequence``), recorded in
+the results file like the others. A ``plan`` reference takes the trial's ``clearance`` and command
+set: the exact methods' ``diagonals``, none for the GAs (their chromosomes have no diagonals), and
+always the diagonals for the heat planner, whose 17 commands (Do et al. 2021) include them.
 
 :func:`run_study` runs the trials ``serial``-ly, on local ``processes`` (the default) or on a
 ``dask`` cluster (a local one, or the scheduler at an address), appends one JSON line per trial to
@@ -157,7 +164,7 @@ EXECUTORS = ("serial", "processes", "dask")
 """Where the trials run: in this process, on a local process pool, on a Dask cluster."""
 
 METRICS = {
-    "plan": ("objectives", "generations", "fitness", "gap", "front", "history", "hv_curve"),
+    "plan": ("objectives", "generations", "fitness", "gap", "heat_fitness", "front", "history", "hv_curve"),
     "tile": (),
     "sequence": ("gap",),
 }
@@ -172,6 +179,13 @@ METRICS = {
   averaged over the legs (Cheng et al. 2020's Table 4);
 - ``gap``: ``reference`` (the exact optimum's time or cost) and ``gap`` = (value − reference) /
   reference; for ``sequence`` only where the optimum is proven (≤ 40 waypoints);
+- ``heat_fitness`` (every plan method): Do et al. 2021's costs of the plan
+  (:func:`~htetro_opt.problems.heat_costs.heat_fitness`, eqs. 9–12 with Fig. 5's safety), so that
+  a GA's, an exact and a heat plan are scored alike: ``heat_f_t``, ``heat_f_sm``, ``heat_f_sf``,
+  with the map's default t_max (a heat trial's own ``t_max`` where it sets one), and ``heat_f``, eq.
+  12 with the heat trial's weights, and equal weights (1, 1, 1) for every other method (a choice of
+  ours: they optimise no such weighting); plus ``shapes_used``, the morphologies the plan's poses
+  take, as letters in order of first use (``"OI"``). None where the goal was not reached;
 - ``front`` (the GA methods only): ``front``, the last leg's leading front as distinct
   ``[f_gr, f_t, f_sm, f_sf]`` rows rounded to 6 decimals, and ``hv``, its hypervolume
   (:func:`hypervolume`); the summary adds ``igd_plus`` (:func:`front_metrics`);
@@ -192,13 +206,15 @@ RUNTIME_FIELDS = ("runtime_s", "reach_time_s")
 _METRIC_FIELDS = {
     "plan": ("reached", "time", "n_commands", "translations", "rotations", "shapeshifts", "path_length",
              "generations", "reach_generation", "reach_time_s", "f_gr", "f_t", "f_sm", "f_sf", "reference", "gap",
-             "hv", "igd_plus"),
+             "heat_f_t", "heat_f_sm", "heat_f_sf", "heat_f", "shapes_used", "hv", "igd_plus"),
     "tile": ("tiles", "overlapping", "n_I", "n_O", "n_L", "n_J", "n_Z", "n_S", "n_T"),
     "sequence": ("cost", "waypoints", "optimal", "reference", "gap"),
 }
 _PLAN_ALIASES = {"exact": "dijkstra"}  # the issue's study files call the minimum-time plan "exact"
+_HEAT_METHODS = ("heat",)  # Do et al. 2021's planner: weights and field options, no seed
+_EQUAL_WEIGHTS = (1.0, 1.0, 1.0)  # heat_f of the plans that optimise no (w_t, w_sm, w_sf)
 _TOP_KEYS = ("name", "description", "task", "scenarios", "seeds", "metrics", "methods")
-_ENTRY_KEYS = ("method", "label", "per_scenario")
+_ENTRY_KEYS = ("method", "label", "scenarios", "per_scenario")
 _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
 
 
@@ -216,9 +232,14 @@ class WorkerLost(HtetroError, RuntimeError):
 def _plan_methods() -> tuple[tuple[str, ...], tuple[str, ...]]:
     from htetro_opt.solvers.grid_paths import EXACT_METHODS, PLAN_METHODS
 
-    # Do et al. 2021's heat planner takes weights, not seeds or GA options: studies get it with its
-    # own option set (not yet), so a study file refuses it as an unknown method for now.
-    return tuple(m for m in PLAN_METHODS if m != "heat") + tuple(_PLAN_ALIASES), tuple(EXACT_METHODS)
+    return tuple(PLAN_METHODS) + tuple(_PLAN_ALIASES), tuple(EXACT_METHODS)
+
+
+def _plan_kind(method: str) -> str:
+    """Which option set a plan method takes: ``"exact"`` (the graph searches), ``"heat"`` or ``"ga"``."""
+    if method in _plan_methods()[1]:
+        return "exact"
+    return "heat" if method in _HEAT_METHODS else "ga"
 
 
 def _methods_of(task: str) -> tuple[str, ...]:
@@ -262,6 +283,42 @@ def _check_start(value, name: str) -> int | str:
         raise ParameterError(f"{name} must be a tile label (a positive integer) or 'free', got {value!r}") from None
 
 
+def _check_heat_weights(value, name: str) -> list[float]:
+    """Eq. 12's (w_t, w_sm, w_sf): three finite numbers ≥ 0, not all zero (a list, or "1,0,0")."""
+    if isinstance(value, str):  # as the command line's "--weights 1,1,1"
+        try:
+            value = [float(v) for v in value.split(",")]
+        except ValueError:
+            raise ParameterError(f"{name} must be three numbers w_t,w_sm,w_sf, got {value!r}") from None
+    if not isinstance(value, (list, tuple)) or len(value) != 3:
+        raise ParameterError(f"{name} must be three numbers [w_t, w_sm, w_sf] (a list, or 'w_t,w_sm,w_sf'), "
+                             f"got {value!r}")
+    values = [check_real(v, f"{name}[{i}]", minimum=0.0) for i, v in enumerate(value)]
+    if sum(values) <= 0:
+        raise ParameterError(f"{name} (w_t, w_sm, w_sf) must not all be zero, got {values}")
+    return values
+
+
+_HEAT_ELEMENTS = ("q1", "p0")  # solve_heat_field's elements (the planner's module keeps them private)
+
+
+def _check_element(value, name: str) -> str:
+    if not isinstance(value, str) or value not in _HEAT_ELEMENTS:
+        raise ParameterError(f"{name} must be one of {', '.join(_HEAT_ELEMENTS)} (the heat field's element), "
+                             f"got {value!r}")
+    return value
+
+
+def _check_band(value, name: str) -> str | int:
+    if value in ("auto", "full"):
+        return value
+    try:
+        return check_int(value, name, minimum=1)
+    except ParameterError:
+        raise ParameterError(f"{name} must be 'auto', 'full' or a radius in cells (an integer ≥ 1), "
+                             f"got {value!r}") from None
+
+
 def _check_weights(value, name: str) -> list[float]:
     from htetro_opt.problems import check_weights
 
@@ -281,7 +338,8 @@ def _check_weights(value, name: str) -> list[float]:
 
 _ALL = None  # an option every method of the task takes
 _OPTIONS: dict[str, dict[str, tuple[Callable, str | None]]] = {
-    # option: (check, which methods take it: None all, "exact" the graph searches, "ga" the others)
+    # option: (check, which methods take it: None all, "exact" the graph searches, "heat" Do et al.
+    # 2021's planner, "ga" the others)
     "plan": {
         "clearance": (_check_clearance, _ALL),
         "diagonals": (check_bool, "exact"),
@@ -289,6 +347,11 @@ _OPTIONS: dict[str, dict[str, tuple[Callable, str | None]]] = {
         "max_gen": (lambda v, n: check_int(v, n, minimum=1), "ga"),
         "patience": (lambda v, n: check_int(v, n, minimum=1), "ga"),
         "max_length": (lambda v, n: check_int(v, n, minimum=1), "ga"),
+        "weights": (_check_heat_weights, "heat"),
+        "t_max": (lambda v, n: check_real(v, n, minimum=0.0, include_minimum=False), "heat"),
+        "element": (_check_element, "heat"),
+        "monotone": (check_bool, "heat"),
+        "band": (_check_band, "heat"),
     },
     "tile": {
         "shapes": (_check_shapes, _ALL),
@@ -306,20 +369,21 @@ _OPTIONS: dict[str, dict[str, tuple[Callable, str | None]]] = {
 _REFERENCE_OPTIONS = {"plan": ("clearance", "diagonals"), "sequence": ("start", "weights", "shapes")}
 
 
+_SCOPE_NAMES = {"exact": "the exact methods (dijkstra, astar)", "heat": "the heat planner (Do et al. 2021)",
+                "ga": "the GA methods"}
+
+
 def _takes(task: str, method: str, scope: str | None) -> bool:
-    if scope is None:
-        return True
-    exact = method in _plan_methods()[1]
-    return exact if scope == "exact" else not exact
+    return scope is None or _plan_kind(method) == scope
 
 
 def _seeded(task: str, method: str, parameters: Mapping[str, Any]) -> bool:
     """Whether the method's result depends on a seed (else the trial runs once, seed None)."""
     if task == "plan":
-        return method not in _plan_methods()[1]
+        return _plan_kind(method) == "ga"
     if task == "tile":
         return bool(parameters.get("shuffle", False))
-    from htetro_opt.studies.seed003 import (
+    from htetro_opt.studies.le2018 import (
         STOCHASTIC,  # the sequencing methods that draw random numbers
     )
 
@@ -387,13 +451,18 @@ def _resolve_scenario(task: str, name, base: Path | None, where: str) -> str:
 # --- the study -------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class MethodSpec:
-    """One method of a study: its canonical name, the label its rows carry, and its options (for
-    every scenario, and per scenario on top of them)."""
+    """One method of a study: its canonical name, the label its rows carry, its options (for every
+    scenario, and per scenario on top of them), and the scenarios it runs on (None: all the study's)."""
 
     method: str
     label: str
     options: Mapping[str, Any] = field(default_factory=dict)
     per_scenario: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    scenarios: tuple[str, ...] | None = None
+
+    def runs_on(self, scenario: str) -> bool:
+        """Whether the method runs on ``scenario`` (a study's resolved scenario)."""
+        return self.scenarios is None or scenario in self.scenarios
 
     def parameters(self, scenario: str) -> dict:
         """The options of a trial on ``scenario``, its own overrides applied, sorted by name."""
@@ -403,6 +472,8 @@ class MethodSpec:
     def as_entry(self) -> dict:
         """The study-file entry of this method."""
         entry = {"method": self.method, "label": self.label, **self.options}
+        if self.scenarios is not None:
+            entry["scenarios"] = list(self.scenarios)
         if self.per_scenario:
             entry["per_scenario"] = {k: dict(v) for k, v in self.per_scenario.items()}
         return entry
@@ -451,8 +522,9 @@ class Study:
         Bundled names or files (``sequence``: labelled tilesets too, or scenarios to tile first).
     methods : sequence of mapping or MethodSpec
         Each a study-file entry: ``method``, an optional ``label`` (default: the method's name, with
-        its options when several entries share it), the verb's options, and ``per_scenario``
-        (scenario → options overriding them there).
+        its options when several entries share it), the verb's options, ``scenarios`` (optional: run
+        it on these of the study's scenarios only) and ``per_scenario`` (scenario → options
+        overriding them there).
     seeds : int or sequence of int
         N for seeds 0 … N−1, or the seeds themselves (default 1). Methods that take no seed run once.
     metrics : sequence of str
@@ -518,6 +590,8 @@ class Study:
         out = []
         for scenario in self.scenarios:
             for spec in self.methods:
+                if not spec.runs_on(scenario):
+                    continue
                 parameters = spec.parameters(scenario)
                 seeds = self.seeds if _seeded(self.task, spec.method, parameters) else (None,)
                 out.extend(Trial(self.task, scenario, spec.method, parameters, seed, spec.label, self.metrics)
@@ -533,12 +607,23 @@ class Study:
 
 def reference_trial(trial: Trial) -> Trial:
     """The exact-optimum trial whose result ``trial``'s gap is measured against: the same scenario
-    with the options that change the optimum (plan: clearance, diagonals; sequence: start, weights,
-    shapes)."""
+    with the options that change the optimum (plan: clearance and the command set; sequence: start,
+    weights, shapes).
+
+    A plan's command set: an exact trial's ``diagonals``, none for a GA (its chromosomes have no
+    diagonals), and the diagonals for the heat planner (``diagonals=True``), whose 17 commands
+    (Do et al. 2021, Cheng et al. 2020's 11 plus the four diagonals) include them: its gap is then
+    to the minimum-time plan over the same commands, 0 for a time-only plan on the optimal route.
+    """
     method = "dijkstra" if trial.task == "plan" else "exact"
     parameters = {k: v for k, v in trial.parameters.items() if k in _REFERENCE_OPTIONS.get(trial.task, ())}
-    if trial.task == "plan" and not _takes("plan", trial.method, "exact"):
-        parameters.pop("diagonals", None)
+    if trial.task == "plan":
+        kind = _plan_kind(trial.method)
+        if kind == "heat":
+            parameters["diagonals"] = True
+        elif kind == "ga":
+            parameters.pop("diagonals", None)
+        parameters = {k: parameters[k] for k in sorted(parameters)}
     return Trial(trial.task, trial.scenario, method, parameters, None, "reference", (), "reference")
 
 
@@ -587,8 +672,9 @@ def _check_ga_metrics(task, method, metrics, where) -> None:
     """Refuse a metric of the GAs' populations (:data:`_GA_METRICS`) for a method that has none."""
     for metric in metrics:
         if metric in _GA_METRICS and not _takes(task, method, "ga"):
-            raise StudyError(f"{where}: metric {metric!r} applies to the GA methods only, not to {method}: an exact "
-                             "planner has no front (metric 'gap' compares the GAs with its optimum)")
+            planner = "the heat planner" if _plan_kind(method) == "heat" else "an exact planner"
+            raise StudyError(f"{where}: metric {metric!r} applies to the GA methods only, not to {method}: {planner} "
+                             "has no population, hence no front (metric 'gap' compares a plan with the optimum)")
 
 
 def _check_options(task, method, options, scenarios, where) -> dict:
@@ -606,8 +692,8 @@ def _check_options(task, method, options, scenarios, where) -> dict:
                              f"{', '.join(list(_ENTRY_KEYS) + list(known))}")
         check, scope = known[key]
         if not _takes(task, method, scope):
-            which = "the GA methods" if scope == "ga" else "the exact methods (dijkstra, astar)"
-            raise StudyError(f"{where}: {key} applies to {which} only, not to {method}")
+            implied = " (it always plans with the diagonals)" if key == "diagonals" and method in _HEAT_METHODS else ""
+            raise StudyError(f"{where}: {key} applies to {_SCOPE_NAMES[scope]} only, not to {method}{implied}")
         if task == "sequence" and key == "shapes":
             tilesets = [s for s in scenarios if _is_tileset(s)]
             if tilesets:
@@ -639,8 +725,9 @@ def _check_methods(task, methods, scenarios, written, where) -> tuple[MethodSpec
         label = entry.get("label")
         if label is not None and (not isinstance(label, str) or not label.strip()):
             raise StudyError(f"{here}: label must be a non-empty string, got {label!r}")
+        own = _check_entry_scenarios(entry.get("scenarios"), scenarios, written, here)
         options = _check_options(task, method, {k: v for k, v in entry.items() if k not in _ENTRY_KEYS},
-                                 scenarios, here)
+                                 scenarios if own is None else own, here)
         per_scenario = entry.get("per_scenario", {})
         if not isinstance(per_scenario, Mapping):
             raise StudyError(f"{here}: per_scenario must be a table of scenario → options, got {per_scenario!r}")
@@ -649,12 +736,15 @@ def _check_methods(task, methods, scenarios, written, where) -> tuple[MethodSpec
             if scenario not in written:
                 raise StudyError(f"{here}: per_scenario.{scenario}: {scenario!r} is not one of the study's "
                                  f"scenarios ({', '.join(map(repr, scenarios))})")
+            if own is not None and written[scenario] not in own:
+                raise StudyError(f"{here}: per_scenario.{scenario}: {scenario!r} is not one of the entry's "
+                                 "scenarios, on which alone it runs")
             overrides[written[scenario]] = _check_options(task, method, scenario_options, [written[scenario]],
                                                           f"{here}, per_scenario.{scenario}")
-        specs.append((name, label, method, options, overrides))
+        specs.append((name, label, method, options, overrides, own))
     names = [name for name, *_ in specs]
     out, labels = [], {}
-    for i, (name, label, method, options, overrides) in enumerate(specs):
+    for i, (name, label, method, options, overrides, own) in enumerate(specs):
         if label is None:
             label = name
             if names.count(name) > 1 and options:
@@ -663,8 +753,25 @@ def _check_methods(task, methods, scenarios, written, where) -> tuple[MethodSpec
             raise StudyError(f"{where}, methods[{i}]: label {label!r} is also methods[{labels[label]}]'s: "
                              "give each entry its own label")
         labels[label] = i
-        out.append(MethodSpec(method, label, options, overrides))
+        out.append(MethodSpec(method, label, options, overrides, own))
     return tuple(out)
+
+
+def _check_entry_scenarios(own, scenarios, written, where) -> tuple[str, ...] | None:
+    """A method entry's ``scenarios``: some of the study's (resolved), in the study's order; None if not given."""
+    if own is None:
+        return None
+    if isinstance(own, str) or not isinstance(own, Sequence) or not own:
+        raise StudyError(f"{where}: scenarios must be a non-empty list of the study's scenarios, got {own!r}")
+    chosen = set()
+    for i, name in enumerate(own):
+        if not isinstance(name, str) or name not in written:
+            raise StudyError(f"{where}: scenarios[{i}] {name!r} is not one of the study's scenarios "
+                             f"({', '.join(map(repr, scenarios))})")
+        if written[name] in chosen:
+            raise StudyError(f"{where}: scenarios[{i}] {name!r} is listed twice")
+        chosen.add(written[name])
+    return tuple(s for s in scenarios if s in chosen)
 
 
 def _text(value) -> str:
@@ -811,7 +918,26 @@ def _plan(scenario, method, parameters, seed, metrics) -> tuple[dict, dict, floa
         out["history"] = _fitness_rows(legs[-1].history, unique=False)
     if "hv_curve" in metrics:
         out["hv_curve"] = [round(float(v), 6) for v in legs[-1].hv_history]
+    if "heat_fitness" in metrics:
+        out.update(_heat_metrics(grid.workspace, plan, method, parameters))
     return out, {"commands": ",".join(plan.tokens)}, plan.runtime_s
+
+
+def _heat_metrics(workspace, plan, method: str, parameters: Mapping[str, Any]) -> dict:
+    """Metric ``heat_fitness``: Do et al. 2021's costs of any plan, and the morphologies it uses."""
+    from htetro_opt.model.robot import STATE_NAMES
+    from htetro_opt.problems import heat_fitness
+
+    names = ("heat_f_t", "heat_f_sm", "heat_f_sf", "heat_f", "shapes_used")
+    if not plan.reached:
+        return dict.fromkeys(names)
+    heat = _plan_kind(method) == "heat"
+    weights = plan.info["weights"] if heat else _EQUAL_WEIGHTS
+    costs = heat_fitness(workspace, plan.poses, plan.commands, t_max=parameters.get("t_max") if heat else None,
+                         weights=weights)
+    shapes = "".join(dict.fromkeys(STATE_NAMES[int(s)] for s in plan.poses[:, 2]))
+    return {"heat_f_t": costs["f_t"], "heat_f_sm": costs["f_sm"], "heat_f_sf": costs["f_sf"], "heat_f": costs["f"],
+            "shapes_used": shapes}
 
 
 def _fitness_rows(fitness, *, unique: bool) -> list[list[float]]:
@@ -893,8 +1019,9 @@ def run_trial(task: str, scenario: str, method: str, parameters: Mapping[str, An
         A method of the task's command-line verb (``plan`` also takes ``exact`` for ``dijkstra``).
     parameters : mapping
         The verb's options, as a study's method entry gives them (``plan``: clearance, diagonals,
-        pop_size, max_gen, patience, max_length; ``tile``: shapes, overlap, shuffle, time_limit;
-        ``sequence``: start, weights, time_limit, shapes).
+        pop_size, max_gen, patience, max_length, and the heat planner's weights, t_max, element,
+        monotone, band; ``tile``: shapes, overlap, shuffle, time_limit; ``sequence``: start,
+        weights, time_limit, shapes).
     seed : int or None
         The seed of a seeded method (None for the others, which run with their default).
     label : str, keyword-only

@@ -41,7 +41,9 @@ def population_arrays(res):
 
 def frozen(**options):
     """An hTetro-GA whose variation operators are never applied (pymoo ``prob`` 0) although each would
-    change every gene it is applied to (rate 1), and with neither repair nor shortcut."""
+    change every gene it is applied to (rate 1), and with neither repair nor shortcut (nor re-planning,
+    unless ``replan_window`` says)."""
+    options = {"replan_window": 0, **options}
     return HTetroGA(pop_size=10, removal=CommandRemoval(1.0, 1.0, prob=0.0),
                     rearrangement=CommandRearrangement(1.0, prob=0.0), mutation=CommandMutation(1.0, prob=0.0),
                     crossover_rate=0.0, repair=False, shortcut=False, **options)
@@ -159,3 +161,61 @@ def test_a_generation_without_offspring_does_not_end_the_run():
     assert recorder.reach_generation == 1
     assert res.data["converged"] is True
     assert len(recorder.history) == 4  # generation 1, then 3 without improvement
+
+
+# --- windowed exact re-planning (ours) ---------------------------------------------------------
+def test_replanning_is_on_by_default_and_off_as_published():
+    ours, paper = HTetroGA(10), HTetroGA.as_published(10)
+    assert ours.replan_window == 40 and ours.replan_members == 3 and ours.replan.window == 40
+    assert paper.replan_window == 0 and paper.replan is None
+    assert make_algorithm("htetro-ga-paper", 10).replan is None
+    assert HTetroGA.as_published(10, replan_window=12).replan.window == 12  # switched back on by name
+    assert HTetroGA(10, replan_window=0).replan is None
+
+
+@pytest.mark.parametrize("options", [dict(replan_window=-1), dict(replan_members=-2), dict(replan_window=1.5),
+                                     dict(replan_window=None)])
+def test_replan_parameters(options):
+    with pytest.raises(ParameterError, match="replan"):
+        HTetroGA(**options)
+    with pytest.raises(ParameterError, match="replan"):
+        make_algorithm("htetro-ga", 10, **{k: v for k, v in options.items() if v is not None} or dict(replan_window=-1))
+
+
+def test_pymoos_algorithms_refuse_a_replan_window():
+    with pytest.raises(ParameterError, match="replan_window"):
+        make_algorithm("nsga2", 10, replan_window=5)
+    assert type(make_algorithm("nsga2", 10, replan_window=0)).__name__ == "NSGA2"
+
+
+def test_the_replanned_fastest_member_joins_the_population():
+    # A wall with the goal behind it; the only initial chromosome that reaches goes the long way round.
+    occ = bordered(14, 10)
+    occ[1:6, 7] = True
+    ws = Workspace(occ)
+    start, goal = Pose(2, 2, "O", 0), Pose(11, 2, "O", 0)
+    detour = parse_commands(",".join(["y+"] * 6 + ["x+"] * 9 + ["y-"] * 6))
+    problem = CommandPathProblem(ws, start, goal, max_length=30)
+    optimum = plan_exact(ws, [start, goal]).time
+    assert problem.simulate([detour]).time[0] > optimum
+
+    def best_time(**options):
+        from htetro_opt.operators import CommandSampling
+
+        algorithm = frozen(sampling=CommandSampling(include=[detour]), **options)
+        res = minimize(problem, algorithm, ("n_gen", 2), seed=0)
+        reached = res.pop.get("reached").astype(bool)
+        return float(res.pop.get("time")[reached].min())
+
+    assert best_time(replan_window=0) == problem.simulate([detour]).time[0]
+    assert best_time(replan_window=len(detour)) == optimum  # the whole path is one window
+
+
+def test_replanning_keeps_the_run_reproducible_and_leaves_the_paper_variant_alone(problem):
+    a = minimize(problem, HTetroGA(pop_size=16, replan_window=8), ("n_gen", 8), seed=2)
+    b = minimize(problem, HTetroGA(pop_size=16, replan_window=8), ("n_gen", 8), seed=2)
+    assert population_arrays(a)[1] == population_arrays(b)[1]
+    paper = minimize(problem, HTetroGA.as_published(16), ("n_gen", 8), seed=2)
+    off = minimize(problem, HTetroGA(16, repair=False, shortcut=False, niche_size=0, replan_window=0), ("n_gen", 8),
+                   seed=2)
+    assert population_arrays(paper)[1] == population_arrays(off)[1]

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from htetro_opt.model import Simulator
-from htetro_opt.scenarios import Scenario, list_scenarios, load_scenario
+from htetro_opt.scenarios import ContinuousScenario, Scenario, list_scenarios, load_scenario
 from htetro_opt.solvers.grid_paths import plan_exact
 
 SEED_000 = ["random", "h_shape", "spiral", "three_slit", "perpendicular_dynamic", "parallel_dynamic"]
@@ -135,3 +135,72 @@ def test_every_bundled_scenario_says_where_it_comes_from_and_what_it_is():
         scenario = load_scenario(name)
         assert scenario.source.strip(), name
         assert scenario.description.strip(), name
+
+
+# --------------------------------------------------------------------------------------------------
+# Nazarahari et al. 2019: Table 1's twelve maps and the four-robot field
+
+EGA_TABLE2 = {  # map: (size, A* grid 1 length of the paper's Table 2)
+    "ega01_random1": (30, 35.79), "ega02_maze1": (50, 251.52), "ega03_home": (50, 132.22),
+    "ega04_corridor1": (30, 33.96), "ega05_boxpile": (30, 48.20), "ega06_corridor2": (30, 68.24),
+    "ega07_slits1": (20, 68.35), "ega08_slits2": (20, 41.45), "ega09_maze2": (50, 197.20),
+    "ega10_maze3": (50, 157.09), "ega11_random2": (30, 43.86), "ega12_plankpile": (30, 51.76),
+}
+
+
+def test_the_library_holds_the_twelve_maps_and_the_four_robot_field(scenarios):
+    assert set(EGA_TABLE2) | {"ega_cross4"} == {n for n in scenarios if n.startswith("ega")}
+
+
+@pytest.mark.parametrize("name", sorted(EGA_TABLE2))
+def test_ega_maps_size_source_and_calibration(scenarios, name):
+    from htetro_opt.solvers.continuous import plan_continuous
+
+    sc = scenarios[name]
+    size, astar = EGA_TABLE2[name]
+    assert isinstance(sc, ContinuousScenario) and (sc.width, sc.height) == (size, size)
+    assert sc.robot_radius == 0 and sc.n_robots == 1
+    number = int(name[3:5])
+    assert PAPER.match(sc.source) and f"Table 1 map {number} " in sc.source and "Fig. 6" in sc.source
+    plan = plan_continuous(sc, method="astar", grid=1.0)
+    assert plan.reached and abs(plan.length / astar - 1) <= 0.10, plan.length
+
+
+def _as_polygons(sc):
+    import shapely
+
+    return [shapely.Polygon(o) for o in sc.obstacles]
+
+
+@pytest.mark.parametrize("name", sorted(EGA_TABLE2))
+def test_ega_maps_have_passages_of_at_least_one_and_no_corner_contacts(scenarios, name):
+    import shapely
+
+    sc = scenarios[name]
+    polygons = _as_polygons(sc)
+    edge = shapely.box(0, 0, sc.width, sc.height).exterior
+    for i, a in enumerate(polygons):
+        assert shapely.box(0, 0, sc.width, sc.height).covers(a)
+        assert a.distance(edge) == 0 or a.distance(edge) >= 1, (i, a.distance(edge))
+        for j in range(i + 1, len(polygons)):
+            gap = a.distance(polygons[j])
+            assert gap == 0 or gap >= 1 - 1e-9, (i, j, gap)
+            if gap == 0:  # pieces that meet share an edge or an area, never a lone corner
+                assert a.intersection(polygons[j]).length > 0 or a.intersection(polygons[j]).area > 0, (i, j)
+    axis_aligned = all(len(o) == 4 and set(o[:, 0]) | set(o[:, 1]) <= set(range(51))
+                       and len(set(o[:, 0])) == 2 and len(set(o[:, 1])) == 2 for o in sc.obstacles)
+    assert axis_aligned == (name != "ega12_plankpile")  # the planks are rotated
+
+
+def test_ega_cross4_robots_planned_alone_meet_at_the_centre(scenarios):
+    from htetro_opt.solvers.continuous import plan_continuous
+
+    sc = scenarios["ega_cross4"]
+    assert sc.robot_radius == 0.5 and sc.n_robots == 4
+    assert sc.starts.tolist() == [[3, 3], [27, 3], [27, 27], [3, 27]]
+    assert sc.goals.tolist() == [[27, 27], [3, 27], [3, 3], [27, 3]]
+    plan = plan_continuous(sc)
+    assert all(len(p) == 2 for p in plan.paths)  # each own optimum is the straight diagonal
+    np.testing.assert_allclose(plan.lengths, 24 * np.sqrt(2))
+    assert plan.min_robot_distance < 2 * sc.robot_radius  # they collide
+    assert len(plan.conflicts) == 6

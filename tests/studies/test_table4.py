@@ -200,7 +200,9 @@ def test_runner_records_are_run_trials(serial):
             assert record["n_commands"] == len(record["commands"].split(","))
         else:
             assert record["gap"] is None and record["time"] is None
-    assert any(r["reached"] for r in records) and any(r["best_gap"] for r in records)  # both cases ran
+    assert any(r["reached"] for r in records)
+    # the best member's gap: measured, never below the optimum (the re-planning GA often sits on it)
+    assert all(r["best_gap"] is not None and r["best_gap"] >= -1e-12 for r in records if r["reached"])
     assert [r["scenario"] for r in serial.references] == ["three_slit", "random"]
 
 

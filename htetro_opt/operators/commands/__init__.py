@@ -10,6 +10,8 @@ takes the ``random_state`` pymoo passes:
   total displacement (:class:`CommandRemoval`, :class:`CommandRearrangement`);
 - :mod:`.repair`: ours, optional: invalid commands replaced by valid ones (:class:`CommandRepair`);
 - :mod:`.shortcut`: ours, optional: cut the longest loop of a path (:class:`CommandShortcut`);
+- :mod:`.replan`: ours, optional: replace a window of a path by the minimum-time path between its
+  ends (:class:`CommandReplan`);
 - :mod:`.duplicates`: :class:`CommandDuplicateElimination`;
 - :mod:`.selection`: the size-4 deterministic tournament on rank and crowding;
 - :mod:`.survival`: the goal-reachability sort (:class:`GoalReachabilitySurvival`).
@@ -22,6 +24,7 @@ from htetro_opt.operators.commands.mutation import CommandMutation, mutate_comma
 from htetro_opt.operators.commands.rearrangement import CommandRearrangement, rearrange_commands
 from htetro_opt.operators.commands.repair import CommandRepair
 from htetro_opt.operators.commands.removal import CommandRemoval, remove_commands
+from htetro_opt.operators.commands.replan import CommandReplan, TransitionGraph, replan_windows
 from htetro_opt.operators.commands.shortcut import (
     CommandShortcut,
     cut_longest_loop,
@@ -42,6 +45,7 @@ __all__ = [
     "CommandRemoval", "remove_commands",
     "CommandRepair",
     "CommandShortcut", "cut_longest_loop", "longest_loops", "shortcut_sequences", "repair_and_shortcut",
+    "CommandReplan", "TransitionGraph", "replan_windows",
     "DEFAULT_SAMPLING_WEIGHTS", "CommandSampling", "sample_commands",
     "RankAndCrowdingTournament", "rank_and_crowding_tournament",
     "GoalReachabilitySurvival", "reaches_goal",

@@ -64,6 +64,8 @@ class Flat:
     def split(self, genes: np.ndarray, keep: np.ndarray | None = None) -> list[np.ndarray]:
         """The chromosomes again, keeping only the genes where ``keep``."""
         if keep is None:
-            return np.split(genes, self.start[1:]) if len(self.length) else []
-        kept = np.bincount(self.owner[keep], minlength=len(self.length))
-        return np.split(genes[keep], np.cumsum(kept)[:-1]) if len(self.length) else []
+            lengths = self.length
+        else:
+            genes, lengths = genes[keep], np.bincount(self.owner[keep], minlength=len(self.length))
+        ends = np.cumsum(lengths)
+        return [genes[a:b] for a, b in zip((ends - lengths).tolist(), ends.tolist())]  # np.split's views, faster

@@ -25,8 +25,8 @@ def chromosome_key(x) -> int:
 
 
 def first_occurrences(X: np.ndarray, seen: set | None = None) -> np.ndarray:
-    """Rows of a design matrix whose chromosome is neither in ``seen`` (a set of
-    :func:`chromosome_key` values, updated in place) nor in an earlier row.
+    """Rows of a design matrix (or items of a list of chromosomes) whose chromosome is neither in
+    ``seen`` (a set of :func:`chromosome_key` values, updated in place) nor in an earlier row.
 
     Examples
     --------
@@ -36,7 +36,8 @@ def first_occurrences(X: np.ndarray, seen: set | None = None) -> np.ndarray:
     """
     seen = set() if seen is None else seen
     keep = []
-    for i, x in enumerate(np.asarray(X, dtype=object).reshape(len(X), -1)[:, 0]):
+    rows = X if isinstance(X, list) else np.asarray(X, dtype=object).reshape(len(X), -1)[:, 0]
+    for i, x in enumerate(rows):
         key = chromosome_key(x)
         if key not in seen:
             seen.add(key)

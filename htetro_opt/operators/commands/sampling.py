@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Mapping
+from typing import Mapping, Sequence
 
 import numpy as np
 from pymoo.core.sampling import Sampling
@@ -79,17 +79,25 @@ class CommandSampling(Sampling):
     weights : mapping of token to float, optional
         λ_mc of each command of the problem's alphabet (default :data:`DEFAULT_SAMPLING_WEIGHTS`); commands
         left out weigh 0.
+    include : sequence of int arrays, keyword-only
+        Chromosomes (global command ids) put first in the sample, e.g. an exact plan (ours: the
+        paper draws every initial chromosome); the rest are drawn, so an empty ``include`` (the
+        default) draws exactly what Algorithm 1 draws.
 
     Raises
     ------
     ParameterError
-        If a weight is negative or all are zero.
+        If a weight is negative or all are zero, or ``include`` is not a sequence of command-id arrays.
     UnknownCommandError
         If a token is not a command.
     """
 
-    def __init__(self, weights: Mapping[str, float] | None = None) -> None:
+    def __init__(self, weights: Mapping[str, float] | None = None, *, include: Sequence = ()) -> None:
         super().__init__()
+        try:
+            self.include = [np.asarray(s, dtype=np.int64).reshape(-1) for s in include]
+        except (TypeError, ValueError) as err:
+            raise ParameterError(f"include must be a sequence of command-id arrays, got {include!r}") from err
         weights = dict(DEFAULT_SAMPLING_WEIGHTS if weights is None else weights)
         for token, w in weights.items():
             command_id(token)
@@ -106,6 +114,7 @@ class CommandSampling(Sampling):
             raise ParameterError(f"sampling weights name commands outside the problem's set: {', '.join(outside)}")
         if weights.sum() <= 0:
             raise ParameterError("sampling weights give zero weight to every command of the problem's set")
-        seqs = sample_commands(random_state, n_samples, commands=alphabet, weights=weights,
+        include = self.include[:n_samples]
+        seqs = sample_commands(random_state, n_samples - len(include), commands=alphabet, weights=weights,
                                durations=problem.durations, t_max=problem.t_max)
-        return as_column(seqs)
+        return as_column(include + seqs)

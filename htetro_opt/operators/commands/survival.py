@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import numpy as np
-from pymoo.core.population import Population
 from pymoo.core.survival import Survival
 from pymoo.operators.survival.rank_and_crowding import RankAndCrowding
+from pymoo.util.randomized_argsort import randomized_argsort
 
 from htetro_opt._validation import check_int
 
-__all__ = ["GoalReachabilitySurvival", "reaches_goal"]
+__all__ = ["GoalReachabilitySurvival", "reaches_goal", "reachability_levels", "rank_and_crowding"]
 
 
 def reaches_goal(F: np.ndarray) -> np.ndarray:
@@ -45,34 +45,101 @@ class GoalReachabilitySurvival(Survival):
         self.niche_size = check_int(niche_size, "niche_size", minimum=0)
         self.ranking = RankAndCrowding(nds=nds, crowding_func=crowding_func)
 
-    def _levels(self, pop) -> np.ndarray:
-        """−f_gr of each individual, with individuals beyond their niche pushed after every level."""
-        F = pop.get("F")
-        levels = F[:, 0].copy()
-        if self.niche_size:
-            unreached = np.flatnonzero(levels != -1.0)
-            ends = pop.get("end")[unreached].astype(np.int64)
-            by_end = np.lexsort((F[unreached, 1:].sum(axis=1), ends))  # best (lowest −sum) first per end
-            order, sorted_ends = unreached[by_end], ends[by_end]
-            starts = np.r_[True, sorted_ends[1:] != sorted_ends[:-1]]
-            group_start = np.maximum.accumulate(np.where(starts, np.arange(len(order)), 0))
-            excess = order[np.arange(len(order)) - group_start >= self.niche_size]
-            levels[excess] += 2.0  # −f_gr lies in [−1, 0]: +2 puts them after every level, in order
-        return levels
+    def sort(self, F: np.ndarray, end: np.ndarray, n_survive: int, *,
+             random_state: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The sort on arrays: the survivors' rows, in order, with their ``rank`` and ``crowding``.
 
-    def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
-        n_survive = len(pop) if n_survive is None else n_survive
-        levels = self._levels(pop)
-        survivors, n_kept, n_ranks = [], 0, 0
+        ``F`` is the (n, 4) objectives and ``end`` each row's final pose id (read only with niching).
+        """
+        levels = reachability_levels(F, end, self.niche_size)
+        rows, ranks, crowdings, n_kept, n_ranks = [], [], [], 0, 0
         for level in np.unique(levels):  # ascending −f_gr: the highest f_gr first
             if n_kept >= n_survive:
                 break
             section = np.flatnonzero(levels == level)
-            take = min(n_survive - n_kept, len(section))
-            kept = self.ranking.do(problem, pop[section], n_survive=take, random_state=random_state)
-            ranks = kept.get("rank") + n_ranks
-            kept.set("rank", ranks)
-            n_ranks = int(ranks.max()) + 1
+            kept, rank, crowding = rank_and_crowding(F[section], min(n_survive - n_kept, len(section)),
+                                                     nds=self.ranking.nds, crowding=self.ranking.crowding_func,
+                                                     random_state=random_state)
+            rows.append(section[kept])
+            ranks.append(rank + n_ranks)
+            crowdings.append(crowding)
+            n_ranks = int(ranks[-1].max()) + 1
             n_kept += len(kept)
-            survivors.append(kept)
-        return survivors[0] if len(survivors) == 1 else Population.merge(*survivors)
+        if not rows:
+            return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
+        return np.concatenate(rows), np.concatenate(ranks), np.concatenate(crowdings)
+
+    def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
+        n_survive = len(pop) if n_survive is None else n_survive
+        F = pop.get("F")
+        end = pop.get("end") if self.niche_size else np.zeros(len(pop), dtype=np.int64)
+        rows, rank, crowding = self.sort(F, end, n_survive, random_state=random_state)
+        survivors = pop[rows]
+        survivors.set("rank", rank, "crowding", crowding)
+        return survivors
+
+
+def reachability_levels(F: np.ndarray, end: np.ndarray, niche_size: int) -> np.ndarray:
+    """−f_gr of each row of ``F``, with the rows beyond their end-pose niche pushed after every level
+    (see :class:`GoalReachabilitySurvival`).
+
+    Examples
+    --------
+    >>> F = np.array([[-1.0, -0.5, 0, 0], [-0.5, -0.2, 0, 0], [-0.5, -0.3, 0, 0], [-0.5, -0.1, 0, 0]])
+    >>> reachability_levels(F, np.array([7, 3, 3, 3]), 2).tolist()  # row 3 is its niche's worst
+    [-1.0, -0.5, -0.5, 1.5]
+    """
+    F = np.asarray(F)
+    levels = F[:, 0].copy()
+    if niche_size:
+        unreached = np.flatnonzero(levels != -1.0)
+        ends = np.asarray(end)[unreached].astype(np.int64)
+        by_end = np.lexsort((F[unreached, 1:].sum(axis=1), ends))  # best (lowest −sum) first per end
+        order, sorted_ends = unreached[by_end], ends[by_end]
+        starts = np.r_[True, sorted_ends[1:] != sorted_ends[:-1]]
+        group_start = np.maximum.accumulate(np.where(starts, np.arange(len(order)), 0))
+        excess = order[np.arange(len(order)) - group_start >= niche_size]
+        levels[excess] += 2.0  # −f_gr lies in [−1, 0]: +2 puts them after every level, in order
+    return levels
+
+
+def rank_and_crowding(F: np.ndarray, n_survive: int, *, nds, crowding,
+                      random_state: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """NSGA-II's survival on arrays: the surviving rows of ``F``, their rank and crowding distance.
+
+    pymoo's ``RankAndCrowding`` survival without its population: ``nds`` (pymoo's compiled
+    non-dominated sorting) ranks until ``n_survive`` are ranked, ``crowding`` (pymoo's crowding
+    function) measures each front, and the front that does not fit keeps its least crowded rows,
+    ties broken at random; the same draws and the same survivors, in the same order.
+
+    Examples
+    --------
+    >>> from pymoo.operators.survival.rank_and_crowding import RankAndCrowding
+    >>> ranking = RankAndCrowding()
+    >>> F = np.array([[0.0, 1.0], [1.0, 0.0], [0.5, 0.5], [1.0, 1.0]])
+    >>> rows, rank, _ = rank_and_crowding(F, 3, nds=ranking.nds, crowding=ranking.crowding_func,
+    ...                                   random_state=np.random.default_rng(0))
+    >>> sorted(rows.tolist()), rank.tolist()
+    ([0, 1, 2], [0, 0, 0])
+    """
+    F = np.asarray(F).astype(float, copy=False)
+    n_survive = min(n_survive, len(F))
+    rows, ranks, crowdings = [], [], []
+    n_kept = 0
+    for k, front in enumerate(nds.do(F, n_stop_if_ranked=n_survive)):
+        front = np.asarray(front)
+        if n_kept + len(front) > n_survive:
+            n_remove = n_kept + len(front) - n_survive
+            distance = crowding.do(F[front, :], n_remove=n_remove)
+            keep = randomized_argsort(distance, order="descending", method="numpy", random_state=random_state)
+            keep = keep[:-n_remove]
+        else:
+            distance = crowding.do(F[front, :], n_remove=0)
+            keep = np.arange(len(front))
+        rows.append(front[keep])
+        ranks.append(np.full(len(keep), k, dtype=np.int64))
+        crowdings.append(np.asarray(distance, dtype=float)[keep])
+        n_kept += len(keep)
+    if not rows:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
+    return np.concatenate(rows).astype(np.int64), np.concatenate(ranks), np.concatenate(crowdings)

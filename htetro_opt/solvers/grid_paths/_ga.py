@@ -5,7 +5,9 @@ moving obstacles) the previous leg's selected solution ended. The algorithm is t
 hTetro-GA by default, or one of pymoo's own (NSGA-II, NSGA-III, SMS-EMOA, AGE-MOEA) with the same
 problem and operators. From each leg's final population it selects, as the paper does, the
 leading-front individual with the largest sum of the four fitnesses (the "multi-objective based
-solution", which the next leg continues from) and the best-f_t, best-f_sm and best-f_sf ones.
+solution") and the best-f_t, best-f_sm and best-f_sf ones; ``pick`` says which of the four the plan
+chains (the next leg continues from it), the largest sum by default. With ``seed_exact`` each leg's
+exact minimum-time plan joins its initial population.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from pymoo.optimize import minimize
 from htetro_opt._progress import check_progress, report
 from htetro_opt._validation import check_bool, check_int, check_seed
 from htetro_opt.algorithms import (
+    PICKS,
     ConvergenceRecorder,
     FrontConvergence,
     leading_front,
@@ -31,6 +34,7 @@ from htetro_opt.model.robot import Pose
 from htetro_opt.model.simulate import Simulator
 from htetro_opt.model.workspace import Workspace, grid_distance
 from htetro_opt.problems.command_path import CommandPathProblem
+from htetro_opt.solvers.grid_paths._exact import plan_exact
 from htetro_opt.solvers.grid_paths._result import FrontMember, LegResult, Plan, finish_plan, prepare
 
 __all__ = ["plan_ga", "default_max_length", "DEFAULT_MAX_LENGTH"]
@@ -103,6 +107,10 @@ def plan_ga(
     verbose: bool = False,
     progress=None,
     hv_reference=None,
+    replan_window: int | None = None,
+    replan_members: int | None = None,
+    seed_exact: bool = False,
+    pick: str = "balanced",
 ) -> Plan:
     """Plan through a roadmap with a command-chromosome GA, one optimisation per leg.
 
@@ -141,12 +149,30 @@ def plan_ga(
         Record each leg's hypervolume by generation against this reference point (in pymoo's
         minimisation space; see :class:`~htetro_opt.algorithms.ConvergenceRecorder`) as
         ``LegResult.hv_history``.
+    replan_window, replan_members : int, optional, keyword-only
+        The hTetro-GA's windowed exact re-planning: each generation a window of up to
+        ``replan_window`` executed commands of the fastest goal-reaching member and of
+        ``replan_members`` random reaching ones is replaced by the minimum-time path between its end
+        poses (ours; :class:`~htetro_opt.operators.commands.CommandReplan`). None: the algorithm's
+        default, W = 40 and 3 members for ``"htetro-ga"``, off for ``"htetro-ga-paper"``; 0 turns it
+        off. pymoo's algorithms refuse a window other than 0.
+    seed_exact : bool, keyword-only
+        Put each leg's exact minimum-time plan (:func:`~htetro_opt.solvers.grid_paths.plan_exact`,
+        from the leg's start at its time) into the leg's initial population, so that the GA spends its
+        generations on the f_sm / f_sf trade-off; the plan's ``info["exact_times"]`` then lists each
+        leg's optimum (None where a leg has no path). Off by default: the GA's own search is what is
+        measured.
+    pick : {"balanced", "fastest", "smoothest", "safest"}, keyword-only
+        The solution each leg chains (:data:`~htetro_opt.algorithms.PICKS`): the leading-front member
+        with the largest sum of the four fitnesses (the paper's multi-objective based solution; the
+        paper also says "the smallest crowding distance", see :data:`~htetro_opt.algorithms.PICKS`),
+        or the best f_t, f_sm or f_sf.
 
     Returns
     -------
     Plan
-        ``method`` is the algorithm's name; ``legs`` holds every leg's record (front, the four
-        selected solutions, convergence). ``reached`` is False when a leg's final population holds
+        ``method`` is the algorithm's name; ``info["pick"]`` the ``pick``; ``legs`` holds every
+        leg's record (front, the four selected solutions, convergence). ``reached`` is False when a leg's final population holds
         no individual reaching its goal; the plan then holds the legs before it (not the failed
         leg's best attempt), ``failed_leg`` says which leg failed, and ``legs`` ends with its record.
 
@@ -167,7 +193,10 @@ def plan_ga(
     >>> plan.reached, plan.time
     (True, 7.0)
     """
-    make_algorithm(algorithm, pop_size)  # validates the name and size before any work
+    make_algorithm(algorithm, pop_size, replan_window=replan_window, replan_members=replan_members)  # validates
+    seed_exact = check_bool(seed_exact, "seed_exact")
+    if not isinstance(pick, str) or pick not in PICKS:
+        raise ParameterError(f"pick must be one of {', '.join(PICKS)}, got {pick!r}")
     max_gen = check_int(max_gen, "max_gen", minimum=1)
     patience = check_int(patience, "patience", minimum=1)
     max_length = check_int(max_length, "max_length", minimum=1, allow_none=True)
@@ -184,15 +213,23 @@ def plan_ga(
     chain: list[np.ndarray] = []
     legs: list[LegResult] = []
     leg_ends: list[int] = []
+    exact_times: list[float | None] = []
     failed, start, t0 = -1, roadmap[0], 0
     for leg, goal in enumerate(roadmap[1:]):
         leg_began = _time.perf_counter()
         length = max_length if max_length is not None else default_max_length(sim.workspace, start, goal)
         problem = CommandPathProblem(sim, start, goal, max_length=length, t0=t0)
+        include = []
+        if seed_exact:
+            exact = plan_exact(sim, [start, goal], t0=t0)
+            exact_times.append(exact.time if exact.reached else None)
+            include = [exact.commands] if exact.reached else []
         recorder = ConvergenceRecorder(leg_began, _reporter(progress, leg, len(roadmap) - 1, max_gen),
                                        hv_reference=reference)
         termination = FrontConvergence(max_gen=max_gen, patience=patience)
-        res = minimize(problem, make_algorithm(algorithm, pop_size, sampling_weights=sampling_weights),
+        res = minimize(problem, make_algorithm(algorithm, pop_size, sampling_weights=sampling_weights,
+                                               replan_window=replan_window, replan_members=replan_members,
+                                               include=include),
                        termination, seed=int(leg_seeds[leg]), callback=recorder, verbose=verbose)
         X, F = res.pop.get("X"), res.pop.get("F")
         chosen = select_solutions(F)
@@ -215,10 +252,11 @@ def plan_ga(
         if not reached:
             failed = leg
             break
-        chain.append(selected["multi_objective"].commands)
+        chain.append(selected[PICKS[pick]].commands)
         t0 += len(chain[-1])
         leg_ends.append(t0)
         start = goal
     commands_all = np.concatenate(chain) if chain else np.empty(0, dtype=np.int64)
+    info = {"pick": pick, **({"exact_times": exact_times} if seed_exact else {})}
     return finish_plan(sim, commands_all, ids[0], method=algorithm, leg_ends=leg_ends, failed_leg=failed,
-                       began=began, legs=legs)
+                       began=began, legs=legs, info=info)

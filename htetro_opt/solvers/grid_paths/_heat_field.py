@@ -258,7 +258,7 @@ def solve_heat_field(workspace, source, sink, *, element: str = "q1", k_obstacle
     if element == "q1":
         dofs, pinches = _q1_dofs(free, split_pinches)
         ey, ex = np.nonzero(used)
-        local = dofs[ey, ex][:, [j for j, _ in _Q1_CORNERS], [i for _, i in _Q1_CORNERS]]  # (n, 4)
+        local = dofs[ey, ex][:, [j for j, _ in _Q1_CORNERS], [i for _, i in _Q1_CORNERS]].astype(np.int32)  # (n, 4)
         ke = q1_element_matrix()
         rows = np.broadcast_to(local[:, :, None], (len(ey), 4, 4)).ravel()
         cols = np.broadcast_to(local[:, None, :], (len(ey), 4, 4)).ravel()
@@ -283,13 +283,20 @@ def solve_heat_field(workspace, source, sink, *, element: str = "q1", k_obstacle
         data = np.concatenate(data + [np.zeros(len(cells))])
         source_dofs, sink_dofs = dofs[sy, sx].reshape(1), dofs[zy, zx].reshape(1)
 
-    # Compact to the dofs of conducting elements.
-    present, inverse = np.unique(np.concatenate([rows, cols]), return_inverse=True)
+    # Compact to the dofs of conducting elements (a lookup table, not np.unique: a million cells give
+    # 16 million entries, whose sort would double the call's time and peak memory).
+    size = int(dofs.max()) + 1
+    seen = np.zeros(size, dtype=bool)
+    seen[rows] = True
+    seen[cols] = True
+    present = np.flatnonzero(seen)
     n = len(present)
-    rows, cols = inverse[:len(rows)], inverse[len(rows):]
-    matrix = coo_matrix((data, (rows, cols)), shape=(n, n)).tocsr()
-    source_dofs = np.searchsorted(present, source_dofs)
-    sink_dofs = np.searchsorted(present, sink_dofs)
+    compact = np.full(size, -1, dtype=np.int32)
+    compact[present] = np.arange(n, dtype=np.int32)
+    matrix = coo_matrix((data, (compact[rows], compact[cols])), shape=(n, n)).tocsr()
+    del rows, cols, data
+    source_dofs = compact[source_dofs]
+    sink_dofs = compact[sink_dofs]
 
     _, label = connected_components(matrix, directed=False)
     connected = bool(label[source_dofs[0]] == label[sink_dofs[0]])
@@ -323,7 +330,7 @@ def solve_heat_field(workspace, source, sink, *, element: str = "q1", k_obstacle
     cells = np.full((h, w), np.nan)
     nodes = corners = None
     if element == "q1":
-        local = np.searchsorted(present, dofs).clip(0, n - 1)
+        local = np.maximum(compact[dofs], 0)  # dofs of no conducting element: masked just below
         corners = np.where(used[:, :, None, None], values[local], np.nan)
         corners[~free] = np.nan
         cells = corners.mean(axis=(2, 3))
@@ -333,7 +340,7 @@ def solve_heat_field(workspace, source, sink, *, element: str = "q1", k_obstacle
         hit = original & ~np.isnan(corners)
         flat[dofs[hit]] = corners[hit]
     else:
-        cells[used] = values[np.searchsorted(present, dofs[used])]
+        cells[used] = values[compact[dofs[used]]]
         cells[~free] = np.nan
     if connected:  # the prescribed cells keep their values, even with shared nodes left free
         cells[sy, sx] = 1.0

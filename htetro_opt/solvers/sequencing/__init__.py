@@ -12,14 +12,21 @@ function of its own:
   hint and the greedy baseline use it too), :func:`improve` / :func:`improve_batch` the one
   2-opt/Or-opt local search (the memetic GA uses it too);
 - ``ga``, ``ga-plain`` (:func:`solve_ga`): the paper's GA on DEAP, with or without a memetic step;
-- ``zigzag``, ``zigzag2``, ``spiral``, ``spiral2``, ``greedy``: the paper's baselines.
+- ``zigzag``, ``zigzag2``, ``spiral``, ``spiral2``, ``greedy``: the paper's baselines;
+- ``fast-tsp`` (:func:`solve_fast_tsp`) and ``lkh`` (:func:`solve_lkh`): outside solvers, optional
+  packages (fast-tsp, MIT; elkai running LKH-3, non-commercial use only).
+
+Instances may be closed tours or open paths with a fixed end, from any cost matrix
+(:meth:`~htetro_opt.problems.SequencingInstance.from_matrix`) or a TSPLIB file
+(:func:`htetro_opt.scenarios.tsplib.load_tsplib`).
 """
 
 from htetro_opt._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
     "sequence_waypoints": "._dispatch", "SequenceResult": "._dispatch", "SEQUENCE_METHODS": "._dispatch",
-    "EXACT_AUTO_LIMIT": "._dispatch", "default_time_limit": "._budgets", "TIME_LIMIT_TEXT": "._budgets",
+    "EXACT_AUTO_LIMIT": "._dispatch", "ASYMMETRIC_METHODS": "._dispatch",
+    "auto_method": "._dispatch", "default_time_limit": "._budgets", "TIME_LIMIT_TEXT": "._budgets",
     "solve_exact": "._exact", "held_karp": "._exact", "EXACT_MAX_SIZE": "._exact",
     "solve_ortools": "._ortools", "ortools_time_limit": "._ortools", "FIRST_SOLUTIONS": "._ortools",
     "solve_local": "._local", "nearest_neighbour": "._local", "nearest_neighbour_paths": "._local",
@@ -28,4 +35,5 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "solve_ga": "._ga", "make_toolbox": "._ga",
     "solve_zigzag": "._baselines", "solve_spiral": "._baselines", "solve_greedy": "._baselines",
     "PATTERN_VARIANTS": "._baselines",
+    "solve_fast_tsp": "._backends", "solve_lkh": "._backends", "FAST_TSP_CANDIDATES": "._backends",
 })

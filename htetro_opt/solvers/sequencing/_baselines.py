@@ -49,6 +49,7 @@ import numpy as np
 
 from htetro_opt._progress import check_progress, report
 from htetro_opt._validation import as_rng, check_int, check_seed, check_time_limit
+from htetro_opt.errors import ParameterError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance, path_cost
 from htetro_opt.solvers.sequencing._budgets import default_time_limit
 from htetro_opt.solvers.sequencing._local import nearest_neighbour_paths
@@ -161,6 +162,9 @@ def _check_pattern_options(rows, seed, time_limit) -> int:
 
 
 def _best_variant(instance: SequencingInstance, canonical, rows: int) -> tuple[np.ndarray, dict]:
+    if not instance.has_geometry:
+        raise ParameterError("the zigzag and spiral patterns scan the tiles' positions, and this instance has no "
+                             "tile geometry (a plain cost matrix): use another method")
     cells = np.asarray(instance.blocks[:, 1], dtype=np.int64)
     h, w = instance.shape
     if h <= 0 or w <= 0:  # an instance built without its grid's shape: use the cells' extent
@@ -216,7 +220,8 @@ def solve_zigzag(instance: SequencingInstance, *, rows: int = 1, seed=0,
     Raises
     ------
     ParameterError
-        If ``rows`` is not a positive integer, or ``seed`` or ``time_limit`` is invalid.
+        If ``rows`` is not a positive integer, ``seed`` or ``time_limit`` is invalid, or the
+        instance has no tile geometry (:meth:`SequencingInstance.from_matrix`).
 
     Examples
     --------
@@ -255,7 +260,8 @@ def solve_spiral(instance: SequencingInstance, *, rows: int = 1, seed=0,
     Raises
     ------
     ParameterError
-        If ``rows`` is not a positive integer, or ``seed`` or ``time_limit`` is invalid.
+        If ``rows`` is not a positive integer, ``seed`` or ``time_limit`` is invalid, or the
+        instance has no tile geometry (:meth:`SequencingInstance.from_matrix`).
 
     Examples
     --------

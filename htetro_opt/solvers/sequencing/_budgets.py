@@ -3,7 +3,8 @@
 A heuristic without a budget can run for many minutes on a large map (the plain GA went past ten
 minutes on the 1004 waypoints of tiling_64x64); with these it ends in seconds to a minute, and
 ``time_limit`` overrides them. The exact method's and OR-Tools' defaults are theirs, the others are
-``base + n / per`` seconds, capped; the geometric patterns take no budget (they are instant).
+``base + n / per`` seconds, capped; the geometric patterns take no budget (they are instant), nor
+does ``lkh`` (elkai runs LKH for a number of runs).
 """
 
 from __future__ import annotations
@@ -12,11 +13,12 @@ __all__ = ["default_time_limit", "TIME_LIMIT_TEXT"]
 
 # method → (base seconds, waypoints per extra second, cap seconds)
 _LINEAR = {"ga": (10.0, 50, 60.0), "ga-plain": (10.0, 50, 60.0), "greedy": (10.0, 100, 30.0),
-           "local": (10.0, 100, 120.0)}
+           "local": (10.0, 100, 120.0), "fast-tsp": (0.5, 400, 30.0)}
 
 TIME_LIMIT_TEXT = ("exact: 60 s; ortools: 1 s up to 20 waypoints, rising to 30 s at 40 and beyond; "
                    "ga, ga-plain: 10 s + 1 s per 50 waypoints, at most 60 s; greedy: 10 s + 1 s per 100 "
                    "waypoints, at most 30 s; local: 10 s + 1 s per 100 waypoints, at most 120 s; "
+                   "fast-tsp: 0.5 s + 1 s per 400 waypoints, at most 30 s; lkh: none (its runs); "
                    "zigzag, spiral: none (instant)")
 """The defaults of :func:`default_time_limit`, in words (the CLI's help shows it)."""
 

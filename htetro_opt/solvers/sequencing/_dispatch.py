@@ -3,9 +3,15 @@
 Every method is a function ``solve_<name>(instance, *, seed=0, time_limit=None, **options)`` that
 returns ``(order, info)``: the waypoint indices in visiting order and a dict of JSON-ready extras
 (``{"optimal": True}``, generation counts, …). :func:`sequence_waypoints` runs one, re-checks that the
-order visits every waypoint once from the start, and prices it with the instance's own cost matrix,
-so a method cannot report a cost its order does not have. A user's callable with the same signature
-is a method too.
+order visits every waypoint once from the start (to the end), and prices it with the instance's own
+cost matrix, so a method cannot report a cost its order does not have. A user's callable with the
+same signature is a method too.
+
+Each method solves the paper's problem, an open path with a fixed or free start. A closed tour or a
+fixed end is handed to a method that does not take it natively (all but ``fast-tsp`` and ``lkh``)
+as that problem, by :func:`~htetro_opt.problems.waypoint_sequencing.reduce_to_open_path`; its order
+is decoded and re-priced on the instance as given. A method that assumes symmetric costs, or needs
+tile geometry, refuses an instance without them before it runs.
 """
 
 from __future__ import annotations
@@ -20,30 +26,38 @@ import numpy as np
 from htetro_opt._progress import check_progress
 from htetro_opt._validation import check_seed, check_time_limit
 from htetro_opt.errors import ParameterError
-from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance
+from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance, reduce_to_open_path
 
-__all__ = ["SEQUENCE_METHODS", "EXACT_AUTO_LIMIT", "SequenceResult", "sequence_waypoints"]
+__all__ = ["SEQUENCE_METHODS", "ASYMMETRIC_METHODS", "EXACT_AUTO_LIMIT", "SequenceResult", "auto_method",
+           "sequence_waypoints"]
 
+# name → (module, function, preset options, capabilities): "asymmetric" (asymmetric costs allowed),
+# "tours" (closed tours and fixed ends taken natively), "geometry" (needs the tiles' block cells)
 _METHODS = {
-    "exact": ("._exact", "solve_exact", {}),
-    "ortools": ("._ortools", "solve_ortools", {}),
-    "local": ("._local", "solve_local", {}),
+    "exact": ("._exact", "solve_exact", {}, {"asymmetric"}),
+    "ortools": ("._ortools", "solve_ortools", {}, {"asymmetric"}),
+    "local": ("._local", "solve_local", {}, set()),
     # the memetic GA finds its best within a few generations; 50 more without improvement suffice
-    "ga": ("._ga", "solve_ga", {"memetic": True, "patience": 50}),
-    "ga-plain": ("._ga", "solve_ga", {"memetic": False}),
-    "zigzag": ("._baselines", "solve_zigzag", {"rows": 1}),
-    "zigzag2": ("._baselines", "solve_zigzag", {"rows": 2}),
-    "spiral": ("._baselines", "solve_spiral", {"rows": 1}),
-    "spiral2": ("._baselines", "solve_spiral", {"rows": 2}),
-    "greedy": ("._baselines", "solve_greedy", {}),
+    "ga": ("._ga", "solve_ga", {"memetic": True, "patience": 50}, set()),
+    "ga-plain": ("._ga", "solve_ga", {"memetic": False}, set()),
+    "zigzag": ("._baselines", "solve_zigzag", {"rows": 1}, {"asymmetric", "geometry"}),
+    "zigzag2": ("._baselines", "solve_zigzag", {"rows": 2}, {"asymmetric", "geometry"}),
+    "spiral": ("._baselines", "solve_spiral", {"rows": 1}, {"asymmetric", "geometry"}),
+    "spiral2": ("._baselines", "solve_spiral", {"rows": 2}, {"asymmetric", "geometry"}),
+    "greedy": ("._baselines", "solve_greedy", {}, {"asymmetric"}),
+    "fast-tsp": ("._backends", "solve_fast_tsp", {}, {"tours"}),
+    "lkh": ("._backends", "solve_lkh", {}, {"asymmetric", "tours"}),
 }
 
 SEQUENCE_METHODS: tuple[str, ...] = ("auto",) + tuple(_METHODS)
 """Method names: ``auto`` (the default), then every method."""
 
+ASYMMETRIC_METHODS: tuple[str, ...] = tuple(name for name, entry in _METHODS.items() if "asymmetric" in entry[3])
+"""The methods that accept an asymmetric cost matrix (the others assume ``cost[i, j] == cost[j, i]``)."""
+
 EXACT_AUTO_LIMIT = 40
-"""``auto`` proves the optimum with the exact solver up to this many waypoints, and runs the local
-search beyond (the winner on the 1000-waypoint benchmark, benchmarks/README.md)."""
+"""``auto`` proves the optimum with the exact solver up to this many waypoints (a closed tour counts
+one more, the copy of its first waypoint); beyond, see :func:`auto_method`."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -75,16 +89,51 @@ def _takes(function, keyword: str) -> bool:
     return any(p.name == keyword or p.kind is p.VAR_KEYWORD for p in parameters)
 
 
-def _resolve(method, n: int) -> tuple[str, object, dict]:
+def auto_method(instance: SequencingInstance) -> str:
+    """The method ``method="auto"`` runs on ``instance``.
+
+    ``exact`` up to :data:`EXACT_AUTO_LIMIT` waypoints (a closed tour counts its copied first
+    waypoint too). Beyond, ``local`` for symmetric costs and ``ortools`` for asymmetric ones.
+
+    Not ``fast-tsp``, although it is clearly better where measured (benchmarks/README.md,
+    "Sequencing backends": within 0.05 % of LKH-3 after 1 s on 200 and 1000 uniform points and on
+    the 1004 eq.-2 waypoints of tiling_64x64, where ``local`` stops 5.1 %, 5.0 % and 2.5 % above):
+    it takes no seed and stops on the clock, so its result depends on the machine's load, and the
+    default must give the same result for the same seed on every machine, whatever optional
+    packages are installed. Ask for it with ``method="fast-tsp"``; ``lkh`` is deterministic but its
+    licence is non-commercial.
+
+    Examples
+    --------
+    >>> asymmetric = np.triu(np.ones((41, 41)))
+    >>> auto_method(SequencingInstance.from_matrix(np.eye(5))), auto_method(SequencingInstance.from_matrix(asymmetric))
+    ('exact', 'ortools')
+    """
+    instance = check_instance(instance)
+    size = instance.n + (1 if instance.closed and instance.n > 1 else 0)
+    if size <= EXACT_AUTO_LIMIT:
+        return "exact"
+    if not instance.symmetric:
+        return "ortools"
+    return "local"
+
+
+def _resolve(method, instance: SequencingInstance) -> tuple[str, object, dict, set]:
     if callable(method):
-        return getattr(method, "__name__", type(method).__name__), method, {}
+        return getattr(method, "__name__", type(method).__name__), method, {}, {"asymmetric", "geometry"}
     if method == "auto":
-        method = "exact" if n <= EXACT_AUTO_LIMIT else "local"
-    if method not in _METHODS:
+        method = auto_method(instance)
+    if not isinstance(method, str) or method not in _METHODS:
         raise ParameterError(f"unknown sequencing method {method!r}: expected one of {', '.join(SEQUENCE_METHODS)} "
                              "or a callable")
-    module, function, preset = _METHODS[method]
-    return method, getattr(import_module(module, __package__), function), preset
+    module, function, preset, capabilities = _METHODS[method]
+    if "geometry" in capabilities and not instance.has_geometry:
+        raise ParameterError(f"method {method!r} scans the tiles' positions, and this instance has no tile geometry "
+                             "(a plain cost matrix): use another method, e.g. auto")
+    if "asymmetric" not in capabilities and not instance.symmetric:
+        raise ParameterError(f"method {method!r} assumes a symmetric cost matrix, and this one is not: use one of "
+                             f"{', '.join(ASYMMETRIC_METHODS)} (or auto)")
+    return method, getattr(import_module(module, __package__), function), preset, capabilities
 
 
 def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, time_limit: float | None = None,
@@ -97,17 +146,20 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, t
         Costs, block cells and start.
     method : str or callable, keyword-only
         One of :data:`SEQUENCE_METHODS`. ``auto`` is the exact solver up to
-        :data:`EXACT_AUTO_LIMIT` waypoints and the local search beyond. A callable
-        ``method(instance, *, seed, time_limit, **options)`` returning ``(order, info)`` is run the same way.
+        :data:`EXACT_AUTO_LIMIT` waypoints and, beyond, fast-tsp when it is installed, else the
+        local search (ortools for asymmetric costs): :func:`auto_method`. A callable
+        ``method(instance, *, seed, time_limit, **options)`` returning ``(order, info)`` is run the
+        same way (given the open-path reduction of a closed tour or a fixed end).
     seed : None, int or numpy.random.Generator, keyword-only
         Seed of the stochastic methods (the deterministic ones and ortools, which has no seed,
         check it and ignore it): an int or a Generator reproduces a run, None draws fresh entropy.
     time_limit : float, optional, keyword-only
         Wall-clock budget in seconds for the methods that take one (exact, ortools, ga, ga-plain,
-        local, greedy): a positive, finite number; None: the method's default, sized to the instance
-        (:func:`default_time_limit`: exact 60 s; ortools 1 s up to 20 waypoints,
-        rising to 30 s at 40; ga, ga-plain 10 s + 1 s per 50 waypoints, at most 60 s; greedy 10 s + 1 s
-        per 100 waypoints, at most 30 s; local 10 s + 1 s per 100 waypoints, at most 120 s).
+        local, greedy, fast-tsp; lkh refuses one): a positive, finite number; None: the method's
+        default, sized to the instance (:func:`default_time_limit`: exact 60 s; ortools 1 s up to 20
+        waypoints, rising to 30 s at 40; ga, ga-plain 10 s + 1 s per 50 waypoints, at most 60 s;
+        greedy 10 s + 1 s per 100 waypoints, at most 30 s; local 10 s + 1 s per 100 waypoints, at
+        most 120 s; fast-tsp 0.5 s + 1 s per 400 waypoints, at most 30 s).
     progress : callable, optional, keyword-only
         ``progress(done, total, note)`` from the methods that report (ga, ga-plain, greedy, local,
         ortools; a callable method that takes a ``progress`` keyword), see :mod:`htetro_opt._progress`.
@@ -121,8 +173,10 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, t
     Raises
     ------
     ParameterError
-        On an unknown method or option value (an infinite ``time_limit`` among them), or an
-        ``instance`` that is not a :class:`SequencingInstance`.
+        On an unknown method or option value (an infinite ``time_limit`` among them), an
+        ``instance`` that is not a :class:`SequencingInstance`, an asymmetric matrix for a method
+        that assumes symmetric costs (see :data:`ASYMMETRIC_METHODS`), a plain matrix for a pattern
+        baseline, or a method whose optional package is missing.
 
     Examples
     --------
@@ -136,12 +190,22 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, t
     time_limit = check_time_limit(time_limit)
     seed = check_seed(seed)
     progress = check_progress(progress)
-    name, function, preset = _resolve(method, instance.n)
+    name, function, preset, capabilities = _resolve(method, instance)
     if progress is not None and _takes(function, "progress"):
         options = {**options, "progress": progress}
+    reduction = None
+    solved = instance
+    if (instance.closed or instance.end is not None) and "tours" not in capabilities:
+        reduction = reduce_to_open_path(instance)
+        solved = reduction.instance
     began = time.perf_counter()
-    order, info = function(instance, seed=seed, time_limit=time_limit, **{**preset, **options})
+    order, info = function(solved, seed=seed, time_limit=time_limit, **{**preset, **options})
     runtime = time.perf_counter() - began
+    info = dict(info)
+    if reduction is not None:
+        order = reduction.decode(solved.check_order(order))
+        if "bound" in info:  # a bound on the reduction's optimum, which exceeds the instance's by the offset
+            info["bound"] = float(info["bound"] - reduction.offset)
     order = instance.check_order(order)
     label = name if method == name or callable(method) else f"{method} ({name})"
-    return SequenceResult(label, order, instance.tile_order(order), instance.path_cost(order), runtime, dict(info))
+    return SequenceResult(label, order, instance.tile_order(order), instance.path_cost(order), runtime, info)

@@ -110,3 +110,90 @@ def test_plan_ga_with_pymoo_algorithm():
     assert plan.method == "nsga2"
     check = Simulator(OPEN).run([plan.commands], START, roadmap=[GOAL])
     assert check.valid[0] and bool(check.reached[0]) == plan.reached
+
+
+# --- seed_exact, pick, the re-planning options ------------------------------------------------
+def test_exact_seeding_puts_the_exact_plan_into_the_initial_population():
+    from htetro_opt.operators import CommandSampling
+    from htetro_opt.problems import CommandPathProblem
+
+    exact = plan_exact(OPEN, [START, GOAL])
+    problem = CommandPathProblem(OPEN, START, GOAL, max_length=20)
+    X = CommandSampling(include=[exact.commands]).do(problem, 8, random_state=np.random.default_rng(0)).get("X")
+    assert len(X) == 8 and X[0, 0].tolist() == exact.commands.tolist()
+    plain = CommandSampling().do(problem, 7, random_state=np.random.default_rng(0)).get("X")
+    assert [x.tolist() for x in X[1:, 0]] == [x.tolist() for x in plain[:, 0]]  # the rest drawn as before
+
+
+def test_seed_exact_gives_the_exact_optimum_as_the_best_time():
+    from htetro_opt.scenarios import load_scenario
+
+    slits = load_scenario("three_slit")  # the GA alone does not get through a slit in 3 generations
+    roadmap = slits.roadmap
+    exact = plan_exact(slits.workspace, roadmap)
+    plan = plan_ga(slits.workspace, roadmap, pop_size=10, max_gen=3, seed=0, seed_exact=True, replan_window=0,
+                   pick="fastest")
+    assert plan.info["exact_times"] == [exact.time]
+    assert plan.legs[0].selected["time"].time == exact.time == plan.time
+    unseeded = plan_ga(slits.workspace, roadmap, pop_size=10, max_gen=3, seed=0, replan_window=0)
+    assert not unseeded.reached and "exact_times" not in unseeded.info
+
+
+@pytest.mark.parametrize("pick, column", [("balanced", None), ("fastest", 1), ("smoothest", 2), ("safest", 3)])
+def test_pick_returns_the_member_with_the_largest_fitness(pick, column):
+    from htetro_opt.algorithms import PICKS
+
+    plan = plan_ga(OPEN, [START, Pose(8, 8, "O", 0)], pop_size=16, max_gen=40, patience=10, max_length=20, seed=2,
+                   pick=pick)
+    leg = plan.legs[0]
+    front = np.array([member.fitness for member in leg.front])
+    score = front.sum(axis=1) if column is None else front[:, column]
+    chosen = leg.selected[PICKS[pick]]
+    assert plan.commands.tolist() == chosen.commands.tolist() and plan.info["pick"] == pick
+    assert (chosen.fitness.sum() if column is None else chosen.fitness[column]) == score.max()
+
+
+def test_pick_seed_exact_and_replan_errors():
+    roadmap = [START, GOAL]
+    for options in (dict(pick="best"), dict(pick=None), dict(seed_exact="yes"), dict(replan_window=-1),
+                    dict(replan_members=-1), dict(algorithm="nsga2", replan_window=4)):
+        with pytest.raises(ParameterError):
+            plan_ga(OPEN, roadmap, max_gen=2, **options)
+
+
+def cli(capsys, argv):
+    from htetro_opt.cli import main
+
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_cli_ga_flags(capsys):
+    import json
+
+    code, out, err = cli(capsys, ["plan", "three_slit", "--method", "htetro-ga", "--pop-size", "10", "--max-gen", "3",
+                                  "--seed-exact", "--pick", "fastest", "--replan-window", "10",
+                                  "--replan-members", "1", "--json", "--quiet"])
+    assert code == 0, err
+    out = json.loads(out)
+    assert out["pick"] == "fastest" and out["gap"] == {"exact": 33.0, "picked": 0.0, "fastest": 0.0}
+    code, out, err = cli(capsys, ["plan", "three_slit", "--method", "htetro-ga", "--pop-size", "10", "--max-gen", "3",
+                                  "--seed-exact", "--quiet"])
+    assert code == 0 and "gap to the exact optimum (33 s): balanced" in out
+
+
+@pytest.mark.parametrize("argv, flag", [
+    (["--method", "htetro-ga", "--replan-window", "-1"], "--replan-window"),
+    (["--method", "htetro-ga", "--replan-members", "-1"], "--replan-members"),
+    (["--method", "htetro-ga", "--replan-window", "x"], "--replan-window"),
+    (["--method", "htetro-ga", "--pick", "best"], "--pick"),
+    (["--method", "nsga2", "--replan-window", "5"], "replan_window"),
+    (["--method", "dijkstra", "--seed-exact"], "--seed-exact"),
+    (["--method", "astar", "--pick", "fastest"], "--pick"),
+    (["--method", "heat", "--replan-window", "5"], "--replan-window"),
+])
+def test_cli_bad_ga_flags_exit_2(capsys, argv, flag):
+    code, out, err = cli(capsys, ["plan", "three_slit", *argv, "--quiet"])
+    assert code == 2 and out == "" and err.startswith("error: ") and len(err.splitlines()) == 1
+    assert flag in err

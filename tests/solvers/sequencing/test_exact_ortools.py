@@ -236,10 +236,10 @@ def test_dispatcher_runs_both(method):
     assert record["method"] == method and "solver" not in record and record["order"] == result.tiles
 
 
-def test_auto_proves_small_instances_and_searches_locally_beyond_the_limit():
+def test_auto_proves_small_instances_and_searches_with_the_local_search_beyond_the_limit():
     small = random_instance("cells", 4, 9, 2)
     result = sequence_waypoints(small)
     assert result.method == "auto (exact)" and result.info["optimal"]
     assert result.cost == pytest.approx(held_karp(small.cost, start=2)[1], rel=1e-9)
     big = random_instance("euclid", 1, 41, 0)
-    assert sequence_waypoints(big).method == "auto (local)"
+    assert sequence_waypoints(big, time_limit=0.2).method == "auto (local)"  # fast-tsp, installed, is not reproducible

@@ -11,30 +11,30 @@ tiles' waypoints by its GA and by zigzag, spiral and greedy baselines, and repor
 - **Tables 4–5**: a coverage simulation on 11 × 11: distance travelled by the blocks, average grid
   coverage time and the share of re-covered cells at heat-map thresholds 150 and 100.
 
-:func:`run_seed003` (with :func:`report`) re-runs all of it on the paper's own labelled tilesets (bundled, transcribed from
+:func:`run_le2018` (with :func:`report`) re-runs all of it on the paper's own labelled tilesets (bundled, transcribed from
 its figures) and on tilings of ours, with every method of :mod:`htetro_opt.solvers.sequencing`, and
 adds what the paper could not report: each method's gap to the proven optimum (the exact method).
 The paper's numbers sit beside ours (``PAPER_*``). Its tables do not say from which tile its paths
 start; ours start from tile 1, as its figures' paths do.
 
 On the study runner (:mod:`htetro_opt.studies.runner`), Tables 1 and 2 are the bundled study
-``seed003`` (``studies/data/seed003.toml``, or :func:`seed003_study`), run by the runner's own
+``le2018`` (``studies/data/le2018.toml``, or :func:`le2018_study`), run by the runner's own
 ``sequence`` trial; :func:`report` lays its records out as today's tables, deriving Table 2's
 equal-weight prices and Tables 4–5's coverage simulation from the recorded orders (both are
 deterministic given an order). Table 3 tiles with a shuffle drawn from a seed, which the runner's
 ``sequence`` task does not do: it stays :func:`run_table3`, passed to :func:`report`::
 
-    from htetro_opt.studies import seed003
+    from htetro_opt.studies import le2018
 
-    run = seed003.run_seed003(seeds=5, out="results")        # or run_study(load_study("seed003"))
-    print(seed003.report(run, table3=seed003.run_table3(seeds=range(2))))
+    run = le2018.run_le2018(seeds=5, out="results")        # or run_study(load_study("le2018"))
+    print(le2018.report(run, table3=le2018.run_table3(seeds=range(2))))
 
 The command line still runs the in-process path::
 
-    htetro-opt study seed003 --seeds 5 --out DIR
+    htetro-opt study le2018 --seeds 5 --out DIR
 
-which prints the markdown tables and, with ``--out``, writes ``DIR/seed003.md`` and
-``DIR/seed003.csv`` (one line per method run).
+which prints the markdown tables and, with ``--out``, writes ``DIR/le2018.md`` and
+``DIR/le2018.csv`` (one line per method run).
 """
 
 from __future__ import annotations
@@ -71,8 +71,8 @@ __all__ = [
     "TABLE1_SCENARIOS",
     "TABLE2_SCENARIOS",
     "STOCHASTIC",
-    "seed003_study",
-    "run_seed003",
+    "le2018_study",
+    "run_le2018",
     "report",
     "run_table1",
     "run_table2",
@@ -327,11 +327,11 @@ def _weights_label(weights: Sequence[float]) -> str:
     return ",".join(f"{float(w):g}" for w in weights)
 
 
-def seed003_study(seeds: int | Sequence[int] = 5, *, methods: Sequence[str] = TABLE1_METHODS,
+def le2018_study(seeds: int | Sequence[int] = 5, *, methods: Sequence[str] = TABLE1_METHODS,
                   weights: bool = True, scenarios: Sequence[str] = TABLE1_SCENARIOS + TABLE2_SCENARIOS,
                   time_limit: float | None = None) -> Study:
     """Tables 1 and 2 as a study of the runner (task ``sequence``, metric ``"gap"``); with the
-    defaults the bundled study ``seed003`` (``load_study("seed003")``).
+    defaults the bundled study ``le2018`` (``load_study("le2018")``).
 
     Parameters
     ----------
@@ -358,7 +358,7 @@ def seed003_study(seeds: int | Sequence[int] = 5, *, methods: Sequence[str] = TA
 
     Examples
     --------
-    >>> study = seed003_study(2, methods=("zigzag", "greedy"), weights=False, scenarios=["paper_6x6_fig13a"])
+    >>> study = le2018_study(2, methods=("zigzag", "greedy"), weights=False, scenarios=["paper_6x6_fig13a"])
     >>> [(t.label, t.seed) for t in study.trials()]
     [('zigzag', None), ('greedy', 0), ('greedy', 1)]
     """
@@ -372,24 +372,24 @@ def seed003_study(seeds: int | Sequence[int] = 5, *, methods: Sequence[str] = TA
                     for w, *_ in PAPER_TABLE2]
     if not isinstance(seeds, numbers.Integral) and isinstance(seeds, Iterable):
         seeds = list(seeds)
-    return Study(name="seed003", task="sequence", scenarios=tuple(scenarios) if isinstance(scenarios, Sequence)
+    return Study(name="le2018", task="sequence", scenarios=tuple(scenarios) if isinstance(scenarios, Sequence)
                  and not isinstance(scenarios, str) else scenarios, methods=entries, seeds=seeds, metrics=("gap",),
                  description="Le et al. 2018, Tables 1, 2, 4 and 5: waypoint sequencing on the paper's tilesets, "
                              "with the gap to the optimum")
 
 
-def run_seed003(seeds: int | Sequence[int] = 5, *, methods: Sequence[str] = TABLE1_METHODS, weights: bool = True,
+def run_le2018(seeds: int | Sequence[int] = 5, *, methods: Sequence[str] = TABLE1_METHODS, weights: bool = True,
                 scenarios: Sequence[str] = TABLE1_SCENARIOS + TABLE2_SCENARIOS, time_limit: float | None = None,
                 executor: str = "processes", workers: int | None = None, out: str | os.PathLike | None = None,
                 resume: bool = False, progress=None) -> StudyRun:
-    """Run :func:`seed003_study` on the study runner (its own ``sequence`` trial); ``report(run)``
+    """Run :func:`le2018_study` on the study runner (its own ``sequence`` trial); ``report(run)``
     lays the result out as the paper's tables.
 
     ``executor``, ``workers``, ``out``, ``resume`` and ``progress`` are
     :func:`~htetro_opt.studies.runner.run_study`'s (``progress(done, total, note)``), the other
-    arguments :func:`seed003_study`'s.
+    arguments :func:`le2018_study`'s.
     """
-    study = seed003_study(seeds, methods=methods, weights=weights, scenarios=scenarios, time_limit=time_limit)
+    study = le2018_study(seeds, methods=methods, weights=weights, scenarios=scenarios, time_limit=time_limit)
     return run_runner_study(study, out=out, executor=executor, workers=workers, resume=resume, progress=progress)
 
 
@@ -474,7 +474,7 @@ def _legacy_records(run: StudyRun) -> list[dict]:
 
 
 def report(run: StudyRun, *, table3: Iterable[dict] | None = None) -> str:
-    """The Markdown tables of a run of the ``seed003`` study, the paper's numbers beside ours: the
+    """The Markdown tables of a run of the ``le2018`` study, the paper's numbers beside ours: the
     same layout as :func:`markdown_report`'s.
 
     Table 1 on each scenario from the records without ``weights`` (each method's gap to the proven
@@ -492,7 +492,7 @@ def report(run: StudyRun, *, table3: Iterable[dict] | None = None) -> str:
     if not isinstance(run, StudyRun):
         raise ParameterError(f"run must be the StudyRun of run_study, got {run!r}")
     if run.study.task != "sequence":
-        raise ParameterError(f"the seed003 report lays out sequencing studies, not task {run.study.task!r}")
+        raise ParameterError(f"the le2018 report lays out sequencing studies, not task {run.study.task!r}")
     records = _legacy_records(run)
     if table3 is not None:
         rows = list(table3)

@@ -10,7 +10,7 @@ from htetro_opt.cli import main as cli_main
 from htetro_opt.errors import ParameterError
 from htetro_opt.problems import SequencingInstance
 from htetro_opt.solvers.sequencing import held_karp
-from htetro_opt.studies import seed003
+from htetro_opt.studies import le2018
 from htetro_opt.studies.runner import StudyRun, load_study, run_study
 
 
@@ -23,12 +23,12 @@ def eq2_cost(tileset, tiles, weights=(0.25,) * 4):
 
 @pytest.fixture(scope="module")
 def fig13b():
-    return seed003.paper_tileset("paper_8x7_fig13b")
+    return le2018.paper_tileset("paper_8x7_fig13b")
 
 
 @pytest.fixture(scope="module")
 def table1(fig13b):
-    return seed003.run_table1(fig13b, seeds=[0, 1], methods=("zigzag", "greedy", "ga-plain", "ga", "exact"))
+    return le2018.run_table1(fig13b, seeds=[0, 1], methods=("zigzag", "greedy", "ga-plain", "ga", "exact"))
 
 
 def test_table1_gaps_are_measured_against_the_proven_optimum(fig13b, table1):
@@ -47,10 +47,10 @@ def test_table1_gaps_are_measured_against_the_proven_optimum(fig13b, table1):
 
 
 def test_table2_prices_each_weight_settings_optimum_with_equal_weights(fig13b):
-    rows = seed003.run_table2(fig13b)
-    assert [r["weights"] for r in rows] == [",".join(f"{w:g}" for w in ws) for ws, *_ in seed003.PAPER_TABLE2]
+    rows = le2018.run_table2(fig13b)
+    assert [r["weights"] for r in rows] == [",".join(f"{w:g}" for w in ws) for ws, *_ in le2018.PAPER_TABLE2]
     equal = rows[-1]
-    for r, (weights, *_) in zip(rows, seed003.PAPER_TABLE2):
+    for r, (weights, *_) in zip(rows, le2018.PAPER_TABLE2):
         assert r["proven"]
         # each setting's optimum, against Held–Karp on that setting's costs
         own = SequencingInstance.from_tileset(fig13b, start=1, weights=weights)
@@ -60,7 +60,7 @@ def test_table2_prices_each_weight_settings_optimum_with_equal_weights(fig13b):
 
 
 def test_table45_covers_every_method_on_one_scale(fig13b, table1):
-    rows = seed003.run_table45(fig13b, table1)
+    rows = le2018.run_table45(fig13b, table1)
     assert [r["method"] for r in rows] == ["zigzag", "greedy", "ga-plain", "ga", "exact"]
     for r in rows:
         # the mean block distance is the eq.-2 cost at equal weights
@@ -72,24 +72,24 @@ def test_table45_covers_every_method_on_one_scale(fig13b, table1):
 
 
 def test_report_puts_the_papers_numbers_beside_ours_and_csv_round_trips(tmp_path, fig13b, table1):
-    records = table1 + seed003.run_table45(fig13b, table1)
-    report = seed003.markdown_report(records)
+    records = table1 + le2018.run_table45(fig13b, table1)
+    report = le2018.markdown_report(records)
     assert "### Table 1 on paper_8x7_fig13b" in report and "62.368" in report  # the paper's GA
     assert "Tables 4–5" in report and "1890" in report
-    path = seed003.write_csv(records, tmp_path / "s.csv")
+    path = le2018.write_csv(records, tmp_path / "s.csv")
     rows = list(csv.DictReader(path.open()))
     assert len(rows) == len(records) and rows[0]["method"] == "zigzag"
 
 
 def test_bad_seeds_and_command_line_errors(capsys):
     with pytest.raises(ParameterError, match="seeds"):
-        seed003.run_table1(None, seeds=[])
+        le2018.run_table1(None, seeds=[])
     for bad in (-1, 1.5, True):
         with pytest.raises(ParameterError, match=r"seeds\[1\] must be a non-negative integer"):
-            seed003.run_table1(None, seeds=[0, bad])
-    assert cli_main(["study", "seed003", "--seeds", "0"]) == 2
-    assert cli_main(["study", "seed003", "--time-limit", "-1"]) == 2
-    assert cli_main(["study", "seed003", "--time-limit", "inf"]) == 2
+            le2018.run_table1(None, seeds=[0, bad])
+    assert cli_main(["study", "le2018", "--seeds", "0"]) == 2
+    assert cli_main(["study", "le2018", "--time-limit", "-1"]) == 2
+    assert cli_main(["study", "le2018", "--time-limit", "inf"]) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 3 and all(line.startswith("error: ") for line in err)
     assert "--seeds" in err[0] and all("--time-limit" in line for line in err[1:])
@@ -97,8 +97,8 @@ def test_bad_seeds_and_command_line_errors(capsys):
 
 @pytest.mark.slow
 def test_the_whole_study_runs_and_writes_its_files(tmp_path):
-    assert cli_main(["study", "seed003", "--seeds", "1", "--out", str(tmp_path)]) == 0
-    assert (tmp_path / "seed003_paper.md").read_text().count("### Table") >= 4
+    assert cli_main(["study", "le2018", "--seeds", "1", "--out", str(tmp_path)]) == 0
+    assert (tmp_path / "le2018_paper.md").read_text().count("### Table") >= 4
 
 
 # --- on the study runner ---------------------------------------------------------------------------
@@ -107,7 +107,7 @@ RUNNER_METHODS = ("zigzag", "spiral2", "greedy", "ga-plain", "ga", "local", "exa
 
 @pytest.fixture(scope="module")
 def runner_run():
-    study = seed003.seed003_study([0, 1], methods=RUNNER_METHODS, scenarios=["paper_8x7_fig13b"])
+    study = le2018.le2018_study([0, 1], methods=RUNNER_METHODS, scenarios=["paper_8x7_fig13b"])
     return run_study(study, executor="serial")
 
 
@@ -123,19 +123,19 @@ def _without_runtimes(text):
 
 
 def test_the_bundled_study_is_the_builders():
-    study = load_study("seed003")
-    assert study == seed003.seed003_study()
+    study = load_study("le2018")
+    assert study == le2018.le2018_study()
     assert study.task == "sequence" and study.metrics == ("gap",)
-    assert study.scenarios == seed003.TABLE1_SCENARIOS + seed003.TABLE2_SCENARIOS
+    assert study.scenarios == le2018.TABLE1_SCENARIOS + le2018.TABLE2_SCENARIOS
     labels = [m.label for m in study.methods]
-    assert labels[:len(seed003.TABLE1_METHODS)] == list(seed003.TABLE1_METHODS)
-    assert [m.options["weights"] for m in study.methods[len(seed003.TABLE1_METHODS):]] == \
-        [list(w) for w, *_ in seed003.PAPER_TABLE2]
+    assert labels[:len(le2018.TABLE1_METHODS)] == list(le2018.TABLE1_METHODS)
+    assert [m.options["weights"] for m in study.methods[len(le2018.TABLE1_METHODS):]] == \
+        [list(w) for w, *_ in le2018.PAPER_TABLE2]
 
 
 def test_the_runner_path_gives_the_old_paths_numbers(fig13b, runner_run):
-    old1 = seed003.run_table1(fig13b, seeds=[0, 1], methods=RUNNER_METHODS)
-    old = {(r["method"], r["seed"] if r["method"] in seed003.STOCHASTIC else None): r for r in old1}
+    old1 = le2018.run_table1(fig13b, seeds=[0, 1], methods=RUNNER_METHODS)
+    old = {(r["method"], r["seed"] if r["method"] in le2018.STOCHASTIC else None): r for r in old1}
     table1 = [r for r in runner_run.records if r.get("weights") is None]
     assert all(r["error"] is None for r in runner_run.records)
     assert {(r["label"], r["seed"]) for r in table1} == set(old)
@@ -145,12 +145,12 @@ def test_the_runner_path_gives_the_old_paths_numbers(fig13b, runner_run):
         assert r["order"] == ",".join(map(str, mine["order"]))
         assert 100 * r["gap"] == pytest.approx(mine["gap_pct"], abs=1e-9)
     weighted = [r for r in runner_run.records if r.get("weights") is not None]
-    old2 = seed003.run_table2(fig13b)
+    old2 = le2018.run_table2(fig13b)
     assert [r["cost"] for r in weighted] == pytest.approx([r["cost_own"] for r in old2], rel=1e-9)
 
     # the report is today's, Tables 2 and 4–5 to the digit, Table 1 but for its runtimes
-    text = seed003.report(runner_run)
-    expected = seed003.markdown_report(old1 + old2 + seed003.run_table45(fig13b, old1))
+    text = le2018.report(runner_run)
+    expected = le2018.markdown_report(old1 + old2 + le2018.run_table45(fig13b, old1))
     assert _without_runtimes(text) == _without_runtimes(expected)
     assert "### Table 1 on paper_8x7_fig13b" in text and "62.368" in text and "1890" in text
 
@@ -161,12 +161,12 @@ def test_the_report_takes_table3_and_lists_failed_trials(runner_run):
     failed = dict(runner_run.records[0], error="TimeoutError: over")
     run = StudyRun(runner_run.study, [failed] + runner_run.records[1:], runner_run.references,
                    runner_run.summary, None)
-    text = seed003.report(run, table3=table3)
+    text = le2018.report(run, table3=table3)
     assert text.index("### Table 2") < text.index("### Table 3") < text.index("### Tables 4–5")
     assert "| tiling_8x7 | x | IJ | 14 | 17.000 | 30.761 |" in text
     assert text.rstrip().endswith("- paper_8x7_fig13b zigzag: TimeoutError: over")
     assert "Zigzag 1 row" not in text.split("### Table 2")[0]
     with pytest.raises(ParameterError, match="StudyRun"):
-        seed003.report(runner_run.records)
+        le2018.report(runner_run.records)
     with pytest.raises(ParameterError, match="run_table3"):
-        seed003.report(runner_run, table3=[{"table": 1}])
+        le2018.report(runner_run, table3=[{"table": 1}])

@@ -1,0 +1,187 @@
+"""One entry point for complete coverage planning, whatever the method."""
+
+from __future__ import annotations
+
+import time as _time
+from typing import Callable
+
+from htetro_opt._validation import check_bool, check_int, check_real, check_time_limit
+from htetro_opt.errors import ParameterError, PlanningError
+from htetro_opt.model.workspace import Workspace, check_workspace
+from htetro_opt.solvers.coverage._baselines import boustrophedon_path, tiling_tsp_tokens
+from htetro_opt.solvers.coverage._layers import LayerGraph, parse_layers
+from htetro_opt.solvers.coverage._result import CoveragePlan, check_end, coverability, finish_coverage
+from htetro_opt.solvers.coverage._stripes import mop_up, plan_stripes, shortest_path, stripe_widths
+
+__all__ = ["plan_coverage", "COVERAGE_METHODS", "DEFAULT_LAYERS", "auto_start"]
+
+COVERAGE_METHODS = ("stripes", "stripes-paper", "boustrophedon", "tiling-tsp")
+"""Method names :func:`plan_coverage` knows: Cheng et al. 2019's stripes with region search (our
+default reading, and the paper's own variant), the one-layer boustrophedon baseline and the tiling +
+TSP baseline."""
+
+DEFAULT_LAYERS = ("O", "vI", "hI")
+"""The paper's best morphology set (Table 2: {O, vI, hI} with 4-row stripes)."""
+
+
+def auto_start(lg: LayerGraph, widths=None):
+    """The bottom-left valid vertex (least x, then least y) of the first listed layer that has one,
+    preferring one inside the first stripe (rows below ``widths[0]``).
+
+    Raises
+    ------
+    PlanningError
+        If no layer of S has a valid pose anywhere on the map.
+    """
+    low, high = lg.rows
+    for layer in range(lg.n_layers):
+        valid = lg.valid[layer]
+        if not valid.any():
+            continue
+        ys, xs = (a for a in valid.nonzero())
+        nodes = [lg.node(layer, int(x), int(y)) for x, y in zip(xs, ys)]
+        inside = [v for v in nodes if widths is None or high[v] < widths[0]]
+        return min(inside or nodes, key=lambda v: (lg.decode(v)[1], lg.decode(v)[2]))
+    names = ", ".join(layer.name for layer in lg.layers)
+    raise PlanningError(f"no pose of the morphology set ({names}) fits anywhere on the map")
+
+
+def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | Callable = "stripes", stripes=4,
+                  start=None, goal=None, region_columns: int = 4, budget: int = 20_000, clearance: float = 0.0,
+                  time_limit: float | None = None, memo: bool = True) -> CoveragePlan:
+    """Plan commands that cover every cell the robot can cover, with one method (Cheng et al. 2019).
+
+    Parameters
+    ----------
+    workspace : Workspace
+    layers : str or sequence of str
+        The morphology set S (:func:`~htetro_opt.solvers.coverage.parse_layers`): ``O``, ``vI``,
+        ``hI`` or ``SHAPE@H``; the paper's best, O, vI, hI, by default. ``"boustrophedon"`` uses
+        the first only.
+    method : str or callable, keyword-only
+        One of :data:`COVERAGE_METHODS`:
+
+        - ``"stripes"`` (default): stripes of rows, each cut into regions of ``region_columns``
+          columns, every region searched for its cheapest covering walk, and one auxiliary DAG
+          (networkx) picking the ports and layers between them (see
+          ``htetro_opt.solvers.coverage._stripes`` for our reading of the paper);
+        - ``"stripes-paper"``: the paper's Alg. 5 as written: regions cut only at forced poses (the
+          only pose of the stripe covering some cell), a depth-first search over simple paths (no
+          vertex twice, §IV-D), and on failure a pose covering an uncovered cell inserted as a cut;
+        - ``"boustrophedon"``: lanes as tall as the first layer's footprint, swept alternately;
+        - ``"tiling-tsp"``: tile the free cells with the layers' shapes (any heading), order the
+          tiles as a TSP and drive through their poses by minimum-command legs.
+
+        Or a callable ``method(layer_graph, start_pose, goal_pose)`` returning command tokens (or
+        ids) from the start; its answer is re-validated like the others'.
+    stripes : int, str or sequence of int, keyword-only
+        Stripe widths bottom up (:func:`~htetro_opt.solvers.coverage.stripe_widths`): an int w is
+        ⌊H / w⌋ bands of w rows, the last taking the remainder. Default 4 (the paper's N_str,2).
+    start : Pose or (x, y, shape, heading), optional, keyword-only
+        The start; by default the bottom-left pose of the first layer in the first stripe.
+    goal : Pose, optional, keyword-only
+        Where the plan must end; by default anywhere (a free end).
+    region_columns : int, keyword-only
+        Columns of a region (default 4).
+    budget : int, keyword-only
+        Search nodes per region search before it falls back to its greedy walk (default 20 000).
+    clearance : float, keyword-only
+        δ in cells (MODEL.md §4).
+    time_limit : float, optional, keyword-only
+        Seconds; past them the remaining regions take their greedy walk (``time_limited``). None: no limit.
+    memo : bool, keyword-only
+        Memoise region searches by their content (True); False gives the same plan, slower.
+
+    Returns
+    -------
+    CoveragePlan
+        Re-validated in the simulator. Cells no pose of S covers, or that the start cannot reach, are
+        reported in ``uncoverable``, not searched for; a plan is ``complete`` when every free cell is covered.
+
+    Raises
+    ------
+    UnknownShapeError
+        If a layer is not one of the accepted forms.
+    ParameterError
+        On an unknown method, stripe widths that are not positive or do not sum to the height,
+        ``region_columns`` or ``budget`` below 1, or a time limit that is not positive.
+    ConfigurationError
+        If the start or goal collides, lies off the map or is in a layer outside S.
+    PlanningError
+        If no pose of S fits anywhere on the map.
+    TilingError
+        ``"tiling-tsp"`` only: if the layers' shapes cannot tile the free cells.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> ws = Workspace(np.zeros((4, 8), dtype=bool))  # 32 free cells: at least (32 - 4) / 2 = 14 O moves
+    >>> plan = plan_coverage(ws, "O", stripes=4)
+    >>> plan.complete, plan.action_cost, plan.regions == plan.regions_optimal
+    (True, 14, True)
+    >>> plan_coverage(ws, "vI").tokens  # the vertical I sweeps 4 new cells a command
+    ['x+', 'x+', 'x+', 'x+', 'x+', 'x+', 'x+']
+    >>> plan_coverage(ws, "O", method="boustrophedon").action_cost
+    14
+    """
+    began = _time.perf_counter()
+    check_workspace(workspace)
+    if not callable(method) and method not in COVERAGE_METHODS:
+        raise ParameterError(f"unknown coverage method {method!r}: expected one of {', '.join(COVERAGE_METHODS)} "
+                             "or a callable")
+    parsed = parse_layers(layers)
+    if method == "boustrophedon":
+        parsed = parsed[:1]
+    widths = stripe_widths(stripes, workspace.height)
+    region_columns = check_int(region_columns, "region_columns", minimum=1)
+    budget = check_int(budget, "budget", minimum=1)
+    clearance = check_real(clearance, "clearance (cells)", minimum=0.0)
+    time_limit = check_time_limit(time_limit)
+    memo = check_bool(memo, "memo")
+    lg = LayerGraph(workspace, parsed, clearance=clearance)
+    start_node = auto_start(lg, widths) if start is None else check_end(lg, start, "start")
+    goal_node = None if goal is None else check_end(lg, goal, "goal")
+    cov = coverability(lg, start_node)
+    if goal_node is not None and not cov.reachable[goal_node]:
+        raise PlanningError(f"the goal {tuple(lg.pose(goal_node))} cannot be reached from the start in this "
+                            "morphology set")
+    name = method if isinstance(method, str) else getattr(method, "__name__", type(method).__name__)
+    if callable(method):
+        tokens = method(lg, lg.pose(start_node), None if goal_node is None else lg.pose(goal_node))
+        if isinstance(tokens, str):
+            tokens = [t for t in tokens.replace(",", " ").split()]
+        return finish_coverage(lg, list(tokens), start_node, method=name, goal_node=goal_node, coverable=cov,
+                               began=began, stripes=())
+    extras: dict = {}
+    if method == "tiling-tsp":
+        tokens, info = tiling_tsp_tokens(lg, start_node, goal_node, time_limit=time_limit)
+        return finish_coverage(lg, tokens, start_node, method=name, goal_node=goal_node, coverable=cov, began=began,
+                               stripes=(), info=info)
+    if method in ("stripes", "stripes-paper"):
+        deadline = None if time_limit is None else began + time_limit
+        outcome = plan_stripes(lg, cov, start_node, goal_node, widths, region_columns=region_columns, budget=budget,
+                               deadline=deadline, memo=memo, paper=method == "stripes-paper")
+        path = outcome.path
+        extras = {"stripes_detail": tuple(outcome.stripes), "regions": outcome.regions,
+                  "regions_optimal": outcome.regions_optimal, "memo_hits": outcome.memo_hits,
+                  "nodes": outcome.nodes, "dag_cost": outcome.dag_cost, "time_limited": outcome.time_limited,
+                  "info": outcome.info}
+        used_stripes = widths
+    else:
+        path = boustrophedon_path(lg, start_node, cov.reachable)
+        extras = {"info": {}}
+        used_stripes = ()
+    lanes = len(path) - 1
+    added = mop_up(lg, path, cov.coverable, cov.reachable)
+    mopup_path = [path[-1]] + added
+    tail = []
+    if goal_node is not None and mopup_path[-1] != goal_node:
+        _, tail = shortest_path(lg, mopup_path[-1], goal_node)
+    tokens_main = lg.commands_of(path)
+    tokens_mop = lg.commands_of(mopup_path)
+    tokens_tail = lg.commands_of(tail) if tail else []
+    if method == "boustrophedon":
+        extras["info"] = {"lane_vertices": lanes}
+    return finish_coverage(lg, tokens_main + tokens_mop + tokens_tail, start_node, method=name, stripes=used_stripes,
+                           goal_node=goal_node, coverable=cov, began=began, mopup_commands=len(tokens_mop),
+                           transit_commands=len(tokens_tail), **extras)

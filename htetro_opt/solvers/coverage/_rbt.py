@@ -1,0 +1,264 @@
+"""The region search of Cheng et al. 2019 (Alg. 5's RBT), as a best-first branch and bound.
+
+A *region* is a small piece of a stripe: a window of the workspace graph (its vertices, local
+numbers 0 … V−1), the target cells it must cover (bit t of an integer mask), an entry vertex and
+an exit vertex (or a free end). A search state is (vertex, covered targets); revisiting vertices is
+allowed, and the table of states already reached at lower cost is Alg. 5's missing loop check (the
+transposition table on (vertex, covered cells) of our reading).
+
+Departure from the paper, stated here: Alg. 5 is a depth-first search with pruning; this is the same
+search ordered best-first (A*), with the same kind of bound: a state costs at least
+``max(distance to the exit, ⌈uncovered / g⌉, max over uncovered targets t of the cheapest way to
+cover t and then reach the exit)``, g being the most new cells one command adds. The bound is
+consistent, so the first state popped at the exit with every target covered is optimal: a search
+that ends within its node budget is a proof. When the budget runs out, the region falls back to the
+greedy walk (nearest vertex covering an uncovered target, then the exit) and is reported as not
+proven optimal.
+
+The paper variant (:func:`search_simple`, :func:`search_inserting`) is Alg. 5 as written: a
+depth-first branch and bound over *simple* paths (no vertex twice: §IV-D's "each vertex is visited
+once", a check Algs. 5–6 lack), moves ordered by new cells, then progress along the sweep; when no
+simple path covers the targets, a pose covering the first uncovered target is inserted (Alg. 5
+l. 12–13) and the two halves are searched apart, each simple.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Region", "RegionResult", "search_region", "greedy_walk", "search_simple", "search_inserting",
+           "MAX_INSERTIONS"]
+
+MAX_INSERTIONS = 8
+"""Poses the paper variant inserts into one region (Alg. 5 l. 12–13) before it takes the greedy walk."""
+
+
+@dataclass(frozen=True, eq=False)
+class Region:
+    """One region's search problem, in local vertex numbers.
+
+    ``adjacency[v]`` lists ``(w, cost)``; ``bits[v]`` the targets v's footprint covers; ``full``
+    all targets; ``dist`` / ``pred`` all-pairs shortest paths in the window (inf / −9999 where none).
+    """
+
+    adjacency: tuple
+    bits: tuple
+    full: int
+    dist: np.ndarray
+    pred: np.ndarray
+    progress: tuple = ()  # per vertex: how far along the sweep its B2 is (the paper variant's move order)
+    target_progress: tuple = ()  # per target bit, likewise
+
+
+@dataclass(frozen=True)
+class RegionResult:
+    cost: int
+    path: tuple[int, ...]  # local vertices, entry first
+    optimal: bool
+    nodes: int
+
+
+def _segment(region: Region, a: int, b: int) -> list[int]:
+    """The shortest path a → b in the window, a first."""
+    path = [b]
+    while path[-1] != a:
+        path.append(int(region.pred[a, path[-1]]))
+    return path[::-1]
+
+
+def greedy_walk(region: Region, entry: int, exit: int | None) -> RegionResult | None:
+    """From the entry, go to the nearest vertex covering an uncovered target (ties: more new targets,
+    then the lower number), until all are covered; then to the exit. None if the exit is unreachable."""
+    dist, bits = region.dist, region.bits
+    if exit is not None and not math.isfinite(dist[entry, exit]):
+        return None
+    cur, mask, path, cost = entry, bits[entry], [entry], 0.0
+    while mask != region.full:
+        unc = region.full & ~mask
+        best = None
+        for u, b in enumerate(bits):
+            if b & unc and math.isfinite(dist[cur, u]):
+                key = (dist[cur, u], -(b & unc).bit_count(), u)
+                if best is None or key < best:
+                    best = key
+        if best is None:
+            return None
+        u = best[2]
+        for w in _segment(region, cur, u)[1:]:
+            mask |= bits[w]
+            path.append(w)
+        cost += dist[cur, u]
+        cur = u
+    if exit is not None and exit != cur:
+        path += _segment(region, cur, exit)[1:]
+        cost += dist[cur, exit]
+    return RegionResult(int(round(cost)), tuple(path), False, 0)
+
+
+def search_region(region: Region, entry: int, exit: int | None, *, gain: int, budget: int) -> RegionResult | None:
+    """The cheapest walk from ``entry`` covering every target and ending at ``exit`` (anywhere for
+    None), by A* over (vertex, covered) with at most ``budget`` expansions; past the budget, the
+    greedy walk. None when the exit cannot be reached or a target cannot be covered."""
+    dist, bits, full = region.dist, region.bits, region.full
+    n = len(bits)
+    if exit is not None and not math.isfinite(dist[entry, exit]):
+        return None
+    dexit = dist[:, exit] if exit is not None else np.zeros(n)
+    targets = [1 << t for t in range(full.bit_length()) if full >> t & 1]
+    covers = [np.flatnonzero([b & t for b in bits]) for t in targets]
+    # via[t][v]: the cheapest way from v to cover target t and then reach the exit.
+    via = np.array([(dist[:, c] + dexit[c]).min(axis=1) if len(c) else np.full(n, np.inf) for c in covers]) \
+        if targets else np.zeros((0, n))
+    if targets and not np.isfinite(via[:, entry]).all():
+        return None
+    dexit_list = dexit.tolist()
+    lists: dict[int, list] = {}
+
+    def bound(v: int, unc: int) -> float:
+        best = dexit_list[v]
+        q = -(-unc.bit_count() // gain)
+        if q > best:
+            best = q
+        order = lists.get(v)
+        if order is None:
+            column = via[:, v]
+            order = lists[v] = [(float(column[t]), targets[t]) for t in np.argsort(-column, kind="stable")]
+        for value, bit in order:
+            if unc & bit:
+                return value if value > best else best
+        return best
+
+    start = (entry, bits[entry])
+    best_g = {start: 0}
+    parent: dict = {start: None}
+    heap = [(bound(entry, full & ~bits[entry]), 0, entry, bits[entry])]
+    expanded = 0
+    adjacency = region.adjacency
+    while heap:
+        f, neg_g, v, mask = heapq.heappop(heap)
+        g = -neg_g
+        if best_g[(v, mask)] < g:
+            continue
+        if mask == full and (exit is None or v == exit):
+            path, state = [], (v, mask)
+            while state is not None:
+                path.append(state[0])
+                state = parent[state]
+            return RegionResult(int(g), tuple(path[::-1]), True, expanded)
+        expanded += 1
+        if expanded > budget:
+            break
+        for w, c in adjacency[v]:
+            m2 = mask | bits[w]
+            g2 = g + c
+            key = (w, m2)
+            if g2 < best_g.get(key, math.inf):
+                h = bound(w, full & ~m2)
+                if h == math.inf:
+                    continue
+                best_g[key] = g2
+                parent[key] = (v, mask)
+                heapq.heappush(heap, (g2 + h, -g2, w, m2))
+    fallback = greedy_walk(region, entry, exit)
+    if fallback is None:
+        return None
+    return RegionResult(fallback.cost, fallback.path, False, expanded)
+
+
+class _Budget(Exception):
+    pass
+
+
+def search_simple(region: Region, entry: int, exit: int | None, *, gain: int, budget: int,
+                  targets: int | None = None) -> RegionResult | None:
+    """The cheapest *simple* walk (no vertex twice) from ``entry`` covering ``targets`` (all by
+    default) and ending at ``exit`` (anywhere for None): a depth-first branch and bound with at most
+    ``budget`` expansions. Past the budget, the best walk found so far (not proven optimal); None
+    when there is none."""
+    full = region.full if targets is None else targets
+    bits = [b & full for b in region.bits]
+    dist = region.dist
+    n = len(bits)
+    if exit is not None and not math.isfinite(dist[entry, exit]):
+        return None
+    dexit = dist[:, exit].tolist() if exit is not None else [0.0] * n
+    progress = region.progress or (0,) * n
+    best_cost, best_path = math.inf, None
+    path, on_path, expanded = [entry], {entry}, 0
+    adjacency = region.adjacency
+
+    def dfs(v: int, mask: int, cost: int) -> None:
+        nonlocal best_cost, best_path, expanded
+        if mask == full and (exit is None or v == exit):
+            if cost < best_cost:
+                best_cost, best_path = cost, tuple(path)
+            return
+        expanded += 1
+        if expanded > budget:
+            raise _Budget
+        unc = full & ~mask
+        if cost + max(dexit[v], -(-unc.bit_count() // gain)) >= best_cost:
+            return
+        moves = sorted(((w, c) for w, c in adjacency[v] if w not in on_path),
+                       key=lambda wc: (-(bits[wc[0]] & unc).bit_count(), -progress[wc[0]], wc[0]))
+        for w, c in moves:
+            path.append(w)
+            on_path.add(w)
+            dfs(w, mask | bits[w], cost + c)
+            on_path.discard(w)
+            path.pop()
+
+    optimal = True
+    try:
+        dfs(entry, bits[entry], 0)
+    except _Budget:
+        optimal = False
+    if best_path is None:
+        return None
+    return RegionResult(int(best_cost), best_path, optimal, expanded)
+
+
+def search_inserting(region: Region, entry: int, exit: int | None, *, gain: int, budget: int) -> RegionResult | None:
+    """Alg. 5 with its failure rule: a simple walk (:func:`search_simple`); failing that, insert the
+    pose nearest the entry that covers the uncovered target earliest along the sweep, and search the
+    halves (targets up to that pose, then the rest) apart, up to :data:`MAX_INSERTIONS` poses; failing
+    that, or past ``budget`` expansions in all, the greedy walk. None when a target or the exit cannot
+    be reached at all."""
+    if exit is not None and not math.isfinite(region.dist[entry, exit]):
+        return None
+    order = region.target_progress or (0,) * region.full.bit_length()
+    spent = [0]
+
+    def solve(a: int, b: int | None, targets: int, depth: int):
+        left = budget - spent[0]  # one budget for the region, insertions included
+        if left <= 0:
+            return None
+        result = search_simple(region, a, b, gain=gain, budget=left, targets=targets)
+        spent[0] += left if result is None else result.nodes
+        if result is not None or depth >= MAX_INSERTIONS:
+            return result
+        unc = targets & ~region.bits[a]
+        if not unc:
+            return None
+        first = min((t for t in range(unc.bit_length()) if unc >> t & 1), key=lambda t: (order[t], t))
+        covers = [v for v, bv in enumerate(region.bits) if bv >> first & 1 and math.isfinite(region.dist[a, v])]
+        if not covers:
+            return None
+        p = min(covers, key=lambda v: (region.dist[a, v], v))
+        before = sum(1 << t for t in range(unc.bit_length()) if unc >> t & 1 and order[t] <= order[first])
+        head = solve(a, p, before, depth + 1)
+        tail = solve(p, b, targets & ~before, depth + 1)
+        if head is None or tail is None:
+            return None
+        return RegionResult(head.cost + tail.cost, head.path + tail.path[1:], False, 0)
+
+    found = solve(entry, exit, region.full, 0)
+    if found is None:
+        found = greedy_walk(region, entry, exit)
+        if found is None:
+            return None
+    return RegionResult(found.cost, found.path, found.optimal, spent[0])

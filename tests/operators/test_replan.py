@@ -1,0 +1,187 @@
+"""Windowed exact re-planning: keeps the start and the end pose, never slower, re-validates, and a
+window holding a detour becomes the exact optimum between its ends (oracle: plan_exact)."""
+
+from __future__ import annotations
+
+import random
+
+import numpy as np
+import pytest
+from pymoo.core.population import Population
+
+from htetro_opt.errors import ParameterError
+from htetro_opt.model import SEED000_COMMANDS, MovingObstacle, Pose, Simulator, Timing, Workspace, parse_commands
+from htetro_opt.model.robot import STATE_NAMES
+from htetro_opt.operators.commands import CommandReplan, TransitionGraph, replan_windows, sequences
+from htetro_opt.problems import CommandPathProblem
+from htetro_opt.solvers.grid_paths import plan_exact
+
+SEED_IDS = parse_commands(",".join(SEED000_COMMANDS))
+
+
+def bordered(width=12, height=12):
+    occ = np.zeros((height, width), dtype=bool)
+    occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
+    return occ
+
+
+def cluttered(seed: int, size: int = 14) -> Workspace:
+    rng = np.random.default_rng(seed)
+    occ = rng.random((size, size)) < 0.12
+    occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
+    occ[1:4, 1:4] = False
+    occ[size - 4 : size - 1, size - 4 : size - 1] = False
+    return Workspace(occ)
+
+
+def walk(problem, rng, n=12, length=60):
+    """Random chromosomes, repaired so that they run their whole genes."""
+    seqs = [rng.choice(SEED_IDS, size=length) for _ in range(n)]
+    result = problem.simulator.run(seqs, problem.start_id, t0=problem.t0, repair=rng)
+    return [result.sequence(i) for i in range(n)]
+
+
+@pytest.mark.parametrize("map_seed", [0, 1, 2, 3])
+@pytest.mark.parametrize("window", [1, 7, 40])
+def test_keeps_start_and_end_pose_never_slower_and_revalidates(map_seed, window):
+    ws = cluttered(map_seed)
+    problem = CommandPathProblem(ws, Pose(2, 2, "O", 0), Pose(11, 11, "O", 0), max_length=30)
+    seqs = walk(problem, np.random.default_rng(map_seed))
+    before = problem.simulate(seqs)
+    out = replan_windows(problem, seqs, window=window, random_state=np.random.default_rng(7))
+    after = problem.simulate(out)
+    changed = 0
+    for k, (old, new) in enumerate(zip(seqs, out)):
+        done, now = int(before.executed[k]), int(after.executed[k])
+        assert after.valid[k] or not before.valid[k]
+        assert np.array_equal(after.poses(k)[0], before.poses(k)[0])  # the start
+        assert np.array_equal(after.poses(k)[-1], before.poses(k)[-1])  # the end pose
+        assert after.time[k] <= before.time[k] + 1e-9
+        assert np.array_equal(new[now:], old[done:])  # the genes after the executed part are kept
+        changed += not np.array_equal(old, new)
+    assert changed  # random walks hold detours: the test would pass vacuously otherwise
+
+
+def test_a_window_holding_a_detour_becomes_the_exact_optimum():
+    occ = bordered(14, 10)
+    occ[1:6, 7] = True  # a wall from the bottom: the straight way is blocked, the way round is over it
+    ws = Workspace(occ)
+    start, goal = Pose(2, 2, "O", 0), Pose(11, 2, "O", 0)
+    # up to the top, across, and down again: a detour of 4 extra cells up and 4 down
+    detour = parse_commands(",".join(["y+"] * 6 + ["x+"] * 9 + ["y-"] * 6))
+    problem = CommandPathProblem(ws, start, goal, max_length=30)
+    assert problem.simulate([detour]).reached[0]
+    [out] = replan_windows(problem, [detour], window=len(detour), random_state=np.random.default_rng(0))
+    oracle = plan_exact(ws, [start, goal])
+    result = problem.simulate([out])
+    assert result.reached[0] and result.time[0] == oracle.time < problem.simulate([detour]).time[0]
+
+
+def test_a_window_in_the_middle_is_replaced_by_the_exact_optimum_between_its_ends():
+    ws = Workspace(bordered(14, 14))
+    start, goal = Pose(3, 5, "O", 0), Pose(11, 5, "O", 0)
+    # x+ x+, then a loop of rotations and shapeshifts, then on: any 6-command window inside it shortens it
+    middle = "r+,sI,r-,sO,r+,r-"
+    path = parse_commands("x+,x+," + middle + ",x+,x+,x+,x+,x+,x+")
+    problem = CommandPathProblem(ws, start, goal, max_length=30)
+    before = problem.simulate([path])
+    assert before.reached[0] and before.executed[0] == len(path)
+    shorter = 0
+    for seed in range(5):
+        rng = np.random.default_rng(seed)
+        i = int(np.random.default_rng(seed).integers(0, len(path) - 6 + 1))  # the window replan draws
+        [out] = replan_windows(problem, [path], window=6, random_state=rng)
+        a, b = before.poses(0)[i], before.poses(0)[i + 6]
+        pose_a, pose_b = (Pose(int(p[0]), int(p[1]), STATE_NAMES[int(p[2])], int(p[3])) for p in (a, b))
+        oracle = plan_exact(ws, [pose_a, pose_b]).time
+        window_time = float(Timing().durations()[path[i : i + 6]].sum())
+        expected = before.time[0] - window_time + min(oracle, window_time)
+        assert problem.simulate([out]).time[0] == pytest.approx(expected)
+        shorter += expected < before.time[0]
+    assert shorter
+
+
+@pytest.mark.parametrize("map_seed", [0, 5])
+def test_the_graph_gives_the_exact_planners_optimum_between_any_two_poses(map_seed):
+    ws = cluttered(map_seed)
+    sim = Simulator(ws)
+    graph = TransitionGraph(sim)
+    rng = np.random.default_rng(map_seed)
+    free = [p for p in (Pose(int(x), int(y), s, int(h)) for x, y, s, h in
+                        zip(rng.integers(1, 13, 60), rng.integers(1, 13, 60), rng.choice(list("IOLT"), 60),
+                            rng.integers(0, 4, 60)))
+            if not sim.pose_conflicts(sim.encode(p))]
+    for a, b in zip(free[0::2], free[1::2]):
+        oracle = plan_exact(ws, [a, b])
+        found = graph.fastest(sim.encode(a), 0, sim.encode(b), 0, limit=1e9)
+        if not oracle.reached:
+            assert found == []
+            continue
+        [(commands, time)] = found
+        check = sim.run([commands], a, roadmap=[b])
+        assert check.valid[0] and check.reached[0] and time == check.time[0] == oracle.time
+
+
+def moving_map():
+    """A corridor crossed by a block that sweeps it up and down: the static optimum runs into it."""
+    occ = bordered(14, 10)
+    occ[8:, :] = True
+    up, down = tuple((0, k) for k in range(6)), tuple((0, k) for k in range(4, 0, -1))
+    return Workspace(occ, moving=(MovingObstacle(cells=((7, 1),), route=up + down, speed=1),))
+
+
+def test_with_moving_obstacles_the_result_revalidates_and_timed_is_the_exact_optimum():
+    ws = moving_map()
+    start, goal = Pose(5, 2, "O", 0), Pose(11, 2, "O", 0)
+    problem = CommandPathProblem(ws, start, goal, max_length=30)
+    oracle = plan_exact(ws, [start, goal])
+    static = plan_exact(Workspace(ws.occupancy), [start, goal])
+    assert oracle.reached and static.time < oracle.time  # the obstacles make the static optimum wait
+    # the oracle's plan after ten waits (do-nothing shapeshifts) at the start
+    slow = np.concatenate([parse_commands(",".join(["sO"] * 10)), oracle.commands])
+    slow_result = problem.simulate([slow])
+    assert slow_result.reached[0]
+    [plain] = replan_windows(problem, [slow], window=len(slow), random_state=np.random.default_rng(0))
+    [timed] = replan_windows(problem, [slow], window=len(slow), random_state=np.random.default_rng(0), timed=True)
+    for out in (plain, timed):
+        result = problem.simulate([out])
+        assert result.valid[0] and result.reached[0] and result.time[0] <= slow_result.time[0]
+    assert problem.simulate([timed]).time[0] == oracle.time
+
+
+def test_random_state_reproducibility_and_global_rng_untouched():
+    ws = cluttered(3)
+    problem = CommandPathProblem(ws, Pose(2, 2, "O", 0), Pose(11, 11, "O", 0), max_length=30)
+    seqs = walk(problem, np.random.default_rng(3))
+    np.random.seed(123)
+    random.seed(123)
+    numpy_state, python_state = np.random.get_state(), random.getstate()
+    a = replan_windows(problem, seqs, window=10, random_state=np.random.default_rng(5))
+    b = replan_windows(problem, seqs, window=10, random_state=np.random.default_rng(5))
+    c = replan_windows(problem, seqs, window=10, random_state=np.random.default_rng(6))
+    assert all(np.array_equal(x, y) for x, y in zip(a, b))
+    assert not all(np.array_equal(x, y) for x, y in zip(a, c))  # the seed draws the windows
+    after = np.random.get_state()
+    assert after[0] == numpy_state[0] and np.array_equal(after[1], numpy_state[1]) and after[2:] == numpy_state[2:]
+    assert random.getstate() == python_state
+
+
+def test_operator_uses_the_problem_and_the_given_random_state_and_builds_its_graph_once():
+    ws = cluttered(1)
+    problem = CommandPathProblem(ws, Pose(2, 2, "O", 0), Pose(11, 11, "O", 0), max_length=30)
+    seqs = walk(problem, np.random.default_rng(1), n=6)
+    operator = CommandReplan(12)
+    pop = operator.do(problem, Population.new("X", np.array(seqs + [None], dtype=object)[:-1, None]),
+                      random_state=np.random.default_rng(2))
+    expected = replan_windows(problem, seqs, window=12, random_state=np.random.default_rng(2))
+    assert all(np.array_equal(x, y) for x, y in zip(sequences(pop.get("X")), expected))
+    assert operator.graph(problem.simulator) is operator.graph(problem.simulator)
+
+
+@pytest.mark.parametrize("window", [0, -3, 2.5, True, None])
+def test_bad_windows(window):
+    with pytest.raises(ParameterError, match="replan window"):
+        CommandReplan(window)
+    problem = CommandPathProblem(Workspace(bordered()), Pose(2, 2, "O", 0), Pose(6, 2, "O", 0), max_length=10)
+    with pytest.raises(ParameterError, match="replan window"):
+        replan_windows(problem, [parse_commands("x+")], window=window, random_state=np.random.default_rng(0))

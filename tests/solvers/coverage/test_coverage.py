@@ -1,0 +1,336 @@
+"""Complete coverage (Cheng et al. 2019): layers, switch costs, plan_coverage's methods and their invariants.
+
+Oracles are independent of the planner: reachability and the cheapest coverage are searched over the
+simulator's own single steps, and a pose "fits" when its four cells are inside the map and free.
+"""
+
+from collections import deque
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from htetro_opt.errors import ConfigurationError, ParameterError, PlanningError, TilingError, UnknownShapeError
+from htetro_opt.model import SEED004_COMMANDS, STATE_NAMES, Pose, Simulator, Workspace, parse_commands
+from htetro_opt.scenarios import load_scenario
+from htetro_opt.solvers import plan_coverage
+from htetro_opt.solvers.coverage import (
+    COVERAGE_METHODS,
+    LayerGraph,
+    parse_layers,
+    stripe_graph,
+    stripe_widths,
+    workspace_graph,
+)
+
+LAYER_TOKENS = ["O", "vI", "hI", "L@1", "T@2", "S@0"]
+BLOCK = ("1l", "1r", "2l", "2r", "3l", "3r", "4l", "4r")
+TRANSLATE = ("x+", "x-", "y+", "y-")
+
+
+def empty(w, h):
+    return Workspace(np.zeros((h, w), dtype=bool))
+
+
+@st.composite
+def maps(draw, low=6, high=14):
+    w, h = draw(st.integers(low, high)), draw(st.integers(low, high))
+    density = draw(st.sampled_from([0.0, 0.1, 0.25]))
+    rng = np.random.default_rng(draw(st.integers(0, 2**16)))
+    return Workspace(rng.random((h, w)) < density)
+
+
+def layer_poses(layers):
+    return {(layer.shape, layer.heading) for layer in parse_layers(layers)}
+
+
+def fits(ws, pose):
+    cells = pose.cells()
+    x, y = cells[:, 0], cells[:, 1]
+    inside = (x >= 0) & (x < ws.width) & (y >= 0) & (y < ws.height)
+    return bool(inside.all() and not ws.occupancy[y, x].any())
+
+
+def brute_coverable(ws, layers, start):
+    """BFS over the simulator's poses by single commands: translations from layer poses, block commands
+    from any state; the union of the visited layer poses' footprints."""
+    sim = Simulator(ws, commands=SEED004_COMMANDS)
+    keys = layer_poses(layers)
+    cols = {t: int(sim.local[parse_commands(t)[0]]) for t in TRANSLATE + BLOCK}
+    first = sim.encode(start)
+    seen, queue = {first}, deque([first])
+    covered = np.zeros((ws.height, ws.width), dtype=bool)
+    while queue:
+        p = queue.popleft()
+        x, y, s, h = (int(v) for v in sim.decode(p))
+        pose = Pose(x, y, STATE_NAMES[s], h)
+        is_layer = (pose.shape, pose.heading) in keys
+        if is_layer:
+            c = pose.cells()
+            covered[c[:, 1], c[:, 0]] = True
+        for token in (TRANSLATE + BLOCK) if is_layer else BLOCK:
+            q = int(sim.next[p, cols[token]])
+            if q != sim.dead and q not in seen:
+                seen.add(q)
+                queue.append(q)
+    return covered
+
+
+# --- layers and switches ----------------------------------------------------------------------------
+
+
+def test_parse_layers_forms_and_errors():
+    assert [(l.name, l.shape, l.heading) for l in parse_layers(["O", "vI", "hI", "I@3", "L@1"])] == [
+        ("O", "O", 0), ("vI", "I", 0), ("hI", "I", 3), ("L@1", "L", 1)]
+    for bad in ("Q", "O@4", "", 3, "L@"):
+        with pytest.raises(UnknownShapeError, match="SHAPE@H"):
+            parse_layers(bad)
+
+
+def test_layers_are_the_papers_morphologies():
+    # Cheng et al. 2019's angle tuples: vI (0,0,0,0), O (0,0,-pi,-pi), hI (-pi/2 x 4)
+    tuples = {"vI": (0, 0, 0, 0), "O": (0, 0, -np.pi, -np.pi), "hI": (-np.pi / 2,) * 4}
+    for name, angles in tuples.items():
+        pose = Pose.from_q((5, 5, *angles))
+        (layer,) = parse_layers(name)
+        assert (pose.shape, pose.heading) == (layer.shape, layer.heading)
+
+
+def test_switch_costs_on_the_free_plane_symmetric_and_revalidated():
+    ws = empty(12, 12)
+    lg = LayerGraph(ws, "O,vI,hI")
+    assert [int(lg.switch_cost[a, b, 6, 6]) for a, b in ((1, 2), (1, 0), (0, 2))] == [1, 2, 3]
+    cost = lg.switch_cost
+    assert (cost == cost.transpose(1, 0, 2, 3)).all()  # symmetric at every cell
+    sim = Simulator(ws, commands=SEED004_COMMANDS)
+    for a in range(3):
+        for b in range(3):
+            if a == b:
+                continue
+            for x, y in ((6, 6), (2, 3), (9, 9)):
+                if cost[a, b, y, x] < 0:
+                    continue
+                tokens = lg.switch_tokens((x, y), a, b)
+                assert len(tokens) == cost[a, b, y, x]
+                run = sim.run([parse_commands(tokens)], lg.layers[a].pose(x, y))
+                assert run.valid[0] and run.final_pose(0) == lg.layers[b].pose(x, y)
+
+
+def test_workspace_graph_matches_the_arrays():
+    ws = Workspace(np.random.default_rng(3).random((7, 8)) < 0.15)
+    lg = LayerGraph(ws, "O,hI")
+    g = workspace_graph(lg)
+    assert g.number_of_nodes() == int(lg.valid.sum())
+    for (na, xa, ya), (nb, xb, yb), data in g.edges(data=True):
+        if data["kind"] == "switch":
+            a, b = ["O", "hI"].index(na), ["O", "hI"].index(nb)
+            assert data["weight"] == lg.switch_cost[a, b, ya, xa] > 0
+        else:
+            assert data["weight"] == 1 and abs(xa - xb) + abs(ya - yb) == 1
+    band = stripe_graph(g, (0, 3))
+    assert all(0 <= min(c[1] for c in d["pose"].cells()) and max(c[1] for c in d["pose"].cells()) < 3
+               for _, d in band.nodes(data=True))
+
+
+# --- options ------------------------------------------------------------------------------------------
+
+
+def test_stripe_widths():
+    assert stripe_widths(3, 16) == (3, 3, 3, 3, 4)
+    assert stripe_widths(4, 16) == (4, 4, 4, 4)
+    assert stripe_widths("2,3,2", 7) == (2, 3, 2)
+    for bad in (0, 17, [4, 4], [0, 16], "a,b", True):
+        with pytest.raises(ParameterError):
+            stripe_widths(bad, 16)
+
+
+@pytest.mark.parametrize("options,error,words", [
+    ({"layers": "Q"}, UnknownShapeError, "SHAPE@H"),
+    ({"stripes": 0}, ParameterError, "stripes"),
+    ({"stripes": [3, 3]}, ParameterError, "sum"),
+    ({"region_columns": 0}, ParameterError, "region_columns"),
+    ({"budget": 0}, ParameterError, "budget"),
+    ({"time_limit": 0}, ParameterError, "time_limit"),
+    ({"method": "zigzag"}, ParameterError, "boustrophedon"),
+    ({"start": (0, 0, "O", 0)}, ConfigurationError, "start"),  # B1 below the map
+    ({"start": (3, 3, "L", 0)}, ConfigurationError, "add it to --shapes"),
+    ({"goal": (30, 3, "O", 0)}, ConfigurationError, "goal"),
+])
+def test_bad_input(options, error, words):
+    options = {"layers": "O", **options}
+    with pytest.raises(error, match=words):
+        plan_coverage(empty(8, 8), options.pop("layers"), **options)
+
+
+def test_no_pose_fits_anywhere():
+    ws = Workspace(np.zeros((3, 8), dtype=bool))
+    with pytest.raises(PlanningError, match="fits"):
+        plan_coverage(ws, "vI", stripes=3)
+
+
+# --- invariants ---------------------------------------------------------------------------------------
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(ws=maps(), data=st.data())
+def test_plans_are_valid_and_cover_every_coverable_cell(ws, data):
+    layers = data.draw(st.lists(st.sampled_from(LAYER_TOKENS), min_size=1, max_size=3, unique=True))
+    width = data.draw(st.integers(2, 4))
+    method = data.draw(st.sampled_from(COVERAGE_METHODS))
+    try:
+        plan = plan_coverage(ws, layers, method=method, stripes=min(width, ws.height))
+    except TilingError:  # the baseline needs a tiling of every free cell
+        assert method == "tiling-tsp"
+        return
+    except PlanningError:  # nothing of S fits: checked against the oracle
+        assert not any(fits(ws, l.pose(x, y)) for l in parse_layers(layers)
+                       for x in range(ws.width) for y in range(ws.height))
+        return
+    used = parse_layers(layers)[:1] if method == "boustrophedon" else parse_layers(layers)
+    # re-validated in an independent simulator, with the plan's poses and time
+    sim = Simulator(ws, commands=SEED004_COMMANDS)
+    run = sim.run([plan.commands], plan.start)
+    assert run.valid[0] and run.time[0] == plan.time == plan.action_cost
+    assert (run.poses(0) == plan.poses).all()
+    assert "stop" not in plan.tokens
+    # coverable = the brute force's, covered between coverable and free
+    expected = brute_coverable(ws, [l.name for l in used], plan.start)
+    assert (plan.coverable == expected).all()
+    assert not (plan.coverable & ~plan.covered).any()
+    assert not (plan.covered & ws.occupancy).any()
+    # every other free cell is reported, for the right reason
+    reported = {(x, y): r for x, y, r in plan.uncoverable}
+    free_rest = {(int(x), int(y)) for y, x in np.argwhere(~ws.occupancy & ~expected)}
+    assert set(reported) == free_rest
+    for (x, y), reason in reported.items():
+        some_fit = any(fits(ws, l.pose(px, py)) and (l.pose(px, py).cells() == (x, y)).all(axis=1).any()
+                       for l in used for px in range(x - 3, x + 4) for py in range(y - 3, y + 4))
+        assert reason == ("unreachable" if some_fit else "no-fit")
+    if method == "stripes":
+        assert plan.dag_cost is None or \
+            plan.action_cost == plan.dag_cost + plan.transit_commands + plan.mopup_commands
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(ws=maps(6, 10), data=st.data())
+def test_deterministic_memo_neutral_and_budget_monotone(ws, data):
+    layers = data.draw(st.lists(st.sampled_from(LAYER_TOKENS[:4]), min_size=1, max_size=3, unique=True))
+    try:
+        plan = plan_coverage(ws, layers, stripes=3)
+    except PlanningError:
+        return
+    again = plan_coverage(ws, layers, stripes=3)
+    no_memo = plan_coverage(ws, layers, stripes=3, memo=False)
+    assert again.tokens == plan.tokens == no_memo.tokens
+    assert no_memo.memo_hits == 0 and plan.regions + plan.memo_hits == no_memo.regions
+    starved = plan_coverage(ws, layers, stripes=3, budget=1)
+    if plan.dag_cost is not None:
+        assert starved.dag_cost >= plan.dag_cost  # more budget never raises a region's cost
+
+
+def brute_cheapest(ws, layers, start):
+    """Fewest commands from ``start`` until every coverable cell is under a visited layer pose:
+    BFS over (simulator pose, covered cells), one command at a time."""
+    sim = Simulator(ws, commands=SEED004_COMMANDS)
+    keys = layer_poses(layers)
+    cols = {t: int(sim.local[parse_commands(t)[0]]) for t in TRANSLATE + BLOCK}
+    names = STATE_NAMES
+    goal = brute_coverable(ws, layers, start)
+    index = {(int(x), int(y)): i for i, (y, x) in enumerate(np.argwhere(goal))}
+    full = (1 << len(index)) - 1
+
+    def mask_of(p):
+        x, y, s, h = (int(v) for v in sim.decode(p))
+        pose = Pose(x, y, names[s], h)
+        if (pose.shape, pose.heading) not in keys:
+            return 0, False
+        return sum(1 << index[(int(cx), int(cy))] for cx, cy in pose.cells()), True
+
+    first = sim.encode(start)
+    state = (first, mask_of(first)[0])
+    seen, frontier, depth = {state}, [state], 0
+    while frontier:
+        if any(m == full for _, m in frontier):
+            return depth
+        nxt = []
+        for p, m in frontier:
+            is_layer = mask_of(p)[1]
+            for token in (TRANSLATE + BLOCK) if is_layer else BLOCK:
+                q = int(sim.next[p, cols[token]])
+                if q == sim.dead:
+                    continue
+                s2 = (q, m | mask_of(q)[0])
+                if s2 not in seen:
+                    seen.add(s2)
+                    nxt.append(s2)
+        frontier, depth = nxt, depth + 1
+    return None
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(w=st.integers(3, 5), h=st.integers(2, 3), seed=st.integers(0, 2**16),
+       layers=st.sampled_from([["O"], ["hI"], ["O", "hI"], ["hI", "L@1"]]))
+def test_one_region_search_is_the_brute_force_optimum(w, h, seed, layers):
+    ws = Workspace(np.random.default_rng(seed).random((h, w)) < 0.15)
+    try:
+        plan = plan_coverage(ws, layers, stripes=h, region_columns=w, budget=10**7)
+    except PlanningError:
+        return
+    if plan.coverable.sum() > 12:  # the brute force's limit (5 x 3 maps with no obstacle)
+        return
+    assert plan.regions == plan.regions_optimal
+    assert plan.mopup_commands == 0
+    assert plan.action_cost == brute_cheapest(ws, layers, plan.start)
+
+
+# --- golden ------------------------------------------------------------------------------------------
+
+
+def test_golden_16x7():
+    sc = load_scenario("coverage_16x7")
+    plan = plan_coverage(sc.workspace, "O,hI", stripes=[2, 3, 2], start=sc.start, goal=sc.goal)
+    assert plan.uncoverable == ((0, 0, "no-fit"),)
+    assert plan.covered[0, 12:16].all()
+    hI_at_13 = [tuple(r) for r in plan.poses.tolist() if tuple(r) == (13, 0, 0, 3)]  # I (state 0) heading 3
+    assert hI_at_13, "(12..15, 0) is covered only by the horizontal I at (13, 0)"
+    assert plan.stripes_detail[-1]["borrowed"] >= 1
+    assert plan.poses[-1].tolist() == [14, 6, 1, 0]  # ends on the goal
+
+
+def test_golden_16x16_table2_pattern():
+    ws = load_scenario("coverage_16x16").workspace
+    costs = {}
+    for layers in (["O"], ["vI"], ["hI"], ["O", "vI"], ["O", "hI"], ["vI", "hI"], ["O", "vI", "hI"]):
+        plan = plan_coverage(ws, layers, stripes=4)
+        assert plan.complete == (layers not in (["vI"], ["hI"])), layers
+        costs[tuple(layers)] = plan.action_cost
+    assert costs[("O", "vI", "hI")] < costs[("O",)]
+    bous = plan_coverage(ws, "O", method="boustrophedon")
+    assert bous.complete and costs[("O",)] <= bous.action_cost
+
+
+def test_callable_method_is_revalidated():
+    ws = empty(6, 4)
+    plan = plan_coverage(ws, "O", method=lambda lg, start, goal: "x+,x+,x+,x+,y+,y+,x-,x-,x-,x-")
+    assert plan.method == "<lambda>" and plan.complete and plan.action_cost == 10
+    with pytest.raises(PlanningError, match="re-validate"):
+        plan_coverage(ws, "O", method=lambda lg, start, goal: ["x-"])
+
+
+def test_time_limit_is_a_result_not_an_error():
+    ws = load_scenario("coverage_16x16").workspace
+    plan = plan_coverage(ws, "O,vI,hI", time_limit=1e-6)
+    assert plan.time_limited and plan.complete
+
+
+def test_a_layer_cut_off_at_the_top_edge_is_still_entered():
+    # At the top of a free map the vertical I cannot switch to the O (B4 would swing off the map), so
+    # the top stripe has two pieces; the vertical I enters its own by the cut-edge and sweeps it.
+    ws = empty(12, 8)
+    lg = LayerGraph(ws, "O,vI")
+    assert (lg.switch_cost[0, 1, 5:, :] < 0).all()
+    alone = plan_coverage(ws, "vI")
+    both = plan_coverage(ws, "O,vI")
+    assert alone.action_cost == 26 == both.action_cost - 2  # + the O -> vI switch at the start
+    assert both.stripes_detail[-1]["cost"] == alone.stripes_detail[-1]["cost"] == 11

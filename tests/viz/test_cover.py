@@ -1,0 +1,83 @@
+"""Plots of coverage plans (Cheng et al. 2019 Figs. 8b, 14, 15): what is drawn matches the plan."""
+
+import matplotlib
+import numpy as np
+import pytest
+
+from htetro_opt.errors import ParameterError
+from htetro_opt.model import Workspace
+from htetro_opt.scenarios import load_scenario
+from htetro_opt.solvers.coverage import plan_coverage
+from htetro_opt.viz import LAYER_COLOURS, plot_cover, plot_cover_heat, save_figure
+
+matplotlib.use("Agg")  # before pyplot is first imported (htetro_opt.viz imports it lazily)
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.colors import to_rgba  # noqa: E402
+
+# (state, heading) of the paper's layers: I is state 0, O state 1
+KEYS = {"O": (1, 0), "vI": (0, 0), "hI": (0, 3)}
+
+
+@pytest.fixture(scope="module")
+def case_16x7():
+    sc = load_scenario("coverage_16x7")
+    plan = plan_coverage(sc.workspace, "O,hI", stripes=[2, 3, 2], start=sc.start, goal=sc.goal)
+    return sc.workspace, plan
+
+
+def by_gid(ax, gid):
+    return [a for a in ax.get_children() if a.get_gid() == gid]
+
+
+def test_arrows_switches_and_markers_match_the_plan(case_16x7, tmp_path):
+    ws, plan = case_16x7
+    fig = plot_cover(ws, plan, title="16 x 7")
+    ax = fig.axes[0]
+    poses = plan.poses
+    for name in plan.layers:
+        (quiver,) = by_gid(ax, f"arrows {name}")
+        state, heading = KEYS[name]
+        moved = [(int(a[0]), int(a[1]), int(b[0] - a[0]), int(b[1] - a[1])) for a, b in zip(poses[:-1], poses[1:])
+                 if (a[2], a[3]) == (state, heading) and (a[0], a[1]) != (b[0], b[1])]
+        drawn = [(int(x), int(y), int(u), int(v)) for (x, y), u, v in zip(quiver.get_offsets(), quiver.U, quiver.V)]
+        assert sorted(drawn) == sorted(moved) and drawn
+        assert to_rgba(quiver.get_facecolor()[0]) == to_rgba(LAYER_COLOURS[name])
+    # one footprint outline per arrival in another layer (unit edges: 8 for an O, 10 for an I)
+    keys = {KEYS[name] for name in plan.layers}
+    layer_poses = [tuple(p) for p in poses.tolist() if tuple(p[2:]) in keys]
+    arrivals = [b for a, b in zip(layer_poses[:-1], layer_poses[1:]) if a[2:] != b[2:]]
+    (switches,) = by_gid(ax, "switch footprints")
+    assert len(arrivals) == plan.switches > 0
+    assert len(switches.get_segments()) == sum(8 if state == 1 else 10 for _, _, state, _ in arrivals)
+    corners = {tuple(c) for seg in switches.get_segments() for c in np.asarray(seg).tolist()}
+    assert all((x + 0.5, y + 0.5) in corners for x, y, _, _ in arrivals)  # outlines around B2's cell
+    (crosses,) = by_gid(ax, "uncoverable")
+    assert crosses.get_offsets().tolist() == [[x, y] for x, y, _ in plan.uncoverable] == [[0, 0]]
+    assert by_gid(ax, "start")[0].get_offsets().tolist() == [[plan.start.x, plan.start.y]]
+    assert by_gid(ax, "goal")[0].get_offsets().tolist() == [[plan.goal.x, plan.goal.y]]
+    assert len([a for a in ax.patches if a.get_gid() == "borrowed rows"]) == plan.stripes_detail[-1]["borrowed"] > 0
+    cuts = by_gid(ax, "region cuts")[0].get_segments()
+    assert sorted({float(s[0][0]) for s in cuts}) == [3.5, 7.5, 11.5]
+    path = save_figure(fig, tmp_path / "cover.png")
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    plt.close(fig)
+
+
+def test_heat_figure_has_map_and_histogram(case_16x7, tmp_path):
+    _, plan = case_16x7
+    fig = plot_cover_heat(plan, title="16 x 7")
+    hist = [p for ax in fig.axes for p in ax.patches if p.get_gid() == "pixel-time histogram"]
+    p = plan.coverage.pixels_per_cell
+    assert sum(bar.get_height() for bar in hist) == plan.free.sum() * p * p
+    assert save_figure(fig, tmp_path / "heat.svg").stat().st_size > 1000
+    plt.close(fig)
+
+
+def test_bad_input():
+    ws = Workspace(np.zeros((4, 6), dtype=bool))
+    with pytest.raises(ParameterError, match="CoveragePlan"):
+        plot_cover(ws, "plan")
+    with pytest.raises(ParameterError, match="map"):
+        plot_cover(Workspace(np.zeros((5, 6), dtype=bool)), plan_coverage(ws, "O"))
+    with pytest.raises(ParameterError, match="bins"):
+        plot_cover_heat(plan_coverage(ws, "O"), bins=0)
