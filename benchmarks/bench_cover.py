@@ -1,10 +1,11 @@
-"""Coverage planning (Cheng et al. 2019): the stripes method beside the boustrophedon baseline.
+"""Coverage planning (Cheng et al. 2019): the stripes method beside the paper's variant and the baselines.
 
 Per case: action cost (commands), the lower bound ⌈(coverable − 4) / g⌉ (g = most new cells one
 command adds), completeness, region searches (run / proven optimal / memo hits / nodes expanded), the
 DAG's size, CPU and wall seconds (one process; the sweep tables are warmed first and timed apart).
 Every plan is re-validated by an independent Simulator replay, and the baseline is asserted to cover
-the same cells.
+the same cells. A second table runs every method (stripes, stripes-paper, boustrophedon, tiling-tsp)
+on the 16 x 16 map with the command-driven coverage metrics.
 
     python benchmarks/bench_cover.py            # the issue's targets
     python benchmarks/bench_cover.py --quick    # the 16 x 16 rows only
@@ -16,6 +17,7 @@ import argparse
 import math
 import time
 
+from htetro_opt.errors import TilingError
 from htetro_opt.model import SEED004_COMMANDS, Simulator, sweep_tables
 from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers import plan_coverage
@@ -77,6 +79,19 @@ def main() -> None:
               f"| {b.action_cost} | {p.regions} ({p.regions_optimal} / {p.memo_hits}) | {p.nodes} "
               f"| {p.info.get('dag_nodes')} / {p.info.get('dag_edges')} | {r['nodes_graph']} / {r['edges_graph']} "
               f"| {r['cpu']:.2f} | {r['wall']:.2f} |")
+    print("\n| map | S | method | complete | cost | avg coverage time | re-covered % | switches | turns | wall s |")
+    print("|---|---|---|---|---:|---:|---:|---:|---:|---:|")
+    for name, layers in (("coverage_16x16", "O"), ("coverage_16x16", "O,vI,hI"), ("coverage_16x7", "O,hI")):
+        for method in ("stripes", "stripes-paper", "boustrophedon", "tiling-tsp"):
+            try:
+                r = run(name, layers, "2,3,2" if name == "coverage_16x7" else 4, method=method)
+            except TilingError as err:
+                print(f"| {name} | {{{layers}}} | {method} | untileable: {str(err).split(':')[0]} | | | | | | |")
+                continue
+            p = r["plan"]
+            print(f"| {name} | {{{layers}}} | {method} | {'yes' if p.complete else 'no'} | {p.action_cost} "
+                  f"| {p.average_coverage_time:.3f} | {p.recovered_pct:.1f} | {p.switches} | {p.turns} "
+                  f"| {r['wall']:.2f} |")
     print("\nbaseline boustrophedon-O CPU s: "
           + ", ".join(f"{k} {v['cpu']:.2f}" for k, v in baselines.items()))
     print(f"total {time.perf_counter() - began:.1f} s")

@@ -39,7 +39,7 @@ from htetro_opt.scenarios import (
     scenario_path,
     tileset_path,
 )
-from htetro_opt.solvers.grid_paths import EXACT_METHODS, PLAN_METHODS, plan_path
+from htetro_opt.solvers.grid_paths import EXACT_METHODS, HEAT_ELEMENTS, PLAN_METHODS, plan_path
 from htetro_opt.solvers.sequencing import SEQUENCE_METHODS, TIME_LIMIT_TEXT, sequence_waypoints
 from htetro_opt.solvers.tiling import TILING_METHODS, tile_workspace
 
@@ -112,7 +112,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="heat: weights of time, smoothness and safety (default 1,0,0)")
     p.add_argument("--t-max", type=float, metavar="S",
                    help="heat: t_max of f_t in seconds (default: half an O-shape boustrophedon of the empty map)")
-    p.add_argument("--element", choices=("q1", "p0"),
+    p.add_argument("--element", choices=HEAT_ELEMENTS,
                    help="heat: the field's element, bilinear q1 (default, the paper's) or cell-centred p0")
     p.add_argument("--no-monotone", action="store_true",
                    help="heat: drop the rule that translations never go down the temperature field")
@@ -221,12 +221,14 @@ def build_parser() -> argparse.ArgumentParser:
         help="plan complete coverage of a scenario (Cheng et al. 2019)",
         description="Plan commands (Cheng et al. 2019's 13) that cover every free cell the robot can cover in the "
         "allowed morphology layers: stripes of rows cut into regions, each searched for its cheapest covering walk, "
-        "joined by one auxiliary DAG; or a one-layer boustrophedon. Cells no allowed pose covers are reported.",
+        "joined by one auxiliary DAG; or a baseline (a one-layer boustrophedon, tiling + TSP). Cells no allowed pose "
+        "covers are reported.",
     )
     p.add_argument("scenario", help="bundled scenario name or path to a scenario TOML file")
-    p.add_argument("--method", choices=("stripes", "boustrophedon"), default="stripes",
-                   help="stripes (default): the paper's stripes, regions and auxiliary DAG; boustrophedon: lanes in "
-                        "the first layer, the baseline")
+    p.add_argument("--method", choices=("stripes", "stripes-paper", "boustrophedon", "tiling-tsp"), default="stripes",
+                   help="stripes (default): the paper's stripes, regions and auxiliary DAG; stripes-paper: its Alg. 5 "
+                        "as written (simple paths, cuts at forced poses); boustrophedon: lanes in the first layer; "
+                        "tiling-tsp: tile with the shapes, order the tiles, drive through them (baselines)")
     p.add_argument("--shapes", default="O,vI,hI",
                    help="morphology layers: O, vI, hI or SHAPE@H, comma-separated (default O,vI,hI)")
     p.add_argument("--stripes", default="4",
@@ -634,15 +636,9 @@ def _replanned(scenario, sensor_range: float, clearance: float, options: dict):
 
 def _heat_weights(text: str | None) -> tuple[float, float, float]:
     """``--weights WT,WSM,WSF`` of the heat planner (Do et al. 2021's eq. 12)."""
-    if text is None:
-        return (1.0, 0.0, 0.0)
-    try:
-        values = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        values = ()
-    if len(values) != 3 or not all(np.isfinite(values)) or min(values) < 0 or sum(values) <= 0:
-        raise ParameterError(f"--weights must be three numbers WT,WSM,WSF >= 0 with a positive sum, got {text!r}")
-    return values
+    from htetro_opt.problems import check_heat_weights
+
+    return (1.0, 0.0, 0.0) if text is None else check_heat_weights(text, "--weights")
 
 
 def _weights(text: str) -> np.ndarray:

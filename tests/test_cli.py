@@ -1062,6 +1062,9 @@ def test_cover_boustrophedon_and_auto_start(capsys):
     assert stripes["goal"] is None and bous["method"] == "boustrophedon"
     code, out, err = run(capsys, ["cover", "coverage_16x7", "--start", "auto", "--shapes", "O,hI"])
     assert code == 0 and "commands" in out.splitlines()[0]
+    for method in ("stripes-paper", "tiling-tsp"):
+        other = run_json(capsys, ["cover", "coverage_16x16", "--method", method, "--shapes", "O,vI,hI", "--json"])
+        assert other["complete"] and other["method"] == method and other["action_cost"] > stripes["action_cost"]
 
 
 @pytest.mark.parametrize("argv,words", [
@@ -1073,6 +1076,7 @@ def test_cover_boustrophedon_and_auto_start(capsys):
     (["--time-limit", "0"], ["--time-limit"]),
     (["--shapes", "hI"], ["start", "--shapes"]),  # the roadmap's start is an O
     (["--method", "zigzag"], ["zigzag"]),
+    (["--method", "tiling-tsp"], ["103 cells"]),  # not a multiple of 4: TilingError
 ])
 def test_cover_bad_options(capsys, argv, words):
     assert_one_error_line(*run(capsys, ["cover", "coverage_16x7", *argv]), *words)

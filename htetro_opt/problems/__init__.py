@@ -22,5 +22,6 @@ __getattr__, __dir__, __all__ = attach(__name__, {
         "path_cost", "check_instance")},
     "SequencingProblem": "._sequencing_problem",
     **{name: ".heat_costs" for name in
-       ("HEAT_COST_NAMES", "SAFETY_RADIUS", "default_t_max", "safety_pattern", "heat_fitness")},
+       ("HEAT_COST_NAMES", "SAFETY_RADIUS", "check_heat_weights", "default_t_max", "safety_pattern",
+        "heat_fitness")},
 })

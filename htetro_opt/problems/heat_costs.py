@@ -42,7 +42,7 @@ from htetro_opt.model.commands import N_COMMANDS, Timing
 from htetro_opt.model.robot import FOOTPRINTS, N_HEADINGS, N_STATES, shape_index
 from htetro_opt.model.workspace import Workspace, check_workspace
 
-__all__ = ["HEAT_COST_NAMES", "SAFETY_RADIUS", "default_t_max", "safety_pattern", "heat_fitness"]
+__all__ = ["HEAT_COST_NAMES", "SAFETY_RADIUS", "check_heat_weights", "default_t_max", "safety_pattern", "heat_fitness"]
 
 HEAT_COST_NAMES = ("f_t", "f_sm", "f_sf", "f")
 """The keys of :func:`heat_fitness`'s answer: eq. 9, eq. 10, Fig. 5's safety, eq. 12."""
@@ -225,13 +225,31 @@ def _check_commands(commands, n: int) -> np.ndarray:
     return array
 
 
-def _check_weights(weights) -> np.ndarray:
-    if isinstance(weights, (str, bytes)) or not hasattr(weights, "__len__") or len(weights) != 3:
-        raise ParameterError(f"weights must be three numbers (w_t, w_sm, w_sf), got {reprlib.repr(weights)}")
-    w = np.array([check_real(v, f"weights[{i}] ({name})", minimum=0.0)
-                  for i, (v, name) in enumerate(zip(weights, ("w_t", "w_sm", "w_sf")))])
-    if w.sum() <= 0:
-        raise ParameterError(f"weights (w_t, w_sm, w_sf) must not all be zero, got {w.tolist()}")
+def check_heat_weights(weights, name: str = "weights") -> tuple[float, float, float]:
+    """Eq. 12's weights (w_t, w_sm, w_sf), checked once for every caller: three finite numbers ≥ 0,
+    not all zero; a string "w_t,w_sm,w_sf" (as on the command line or in a study file) is read too.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``name`` (e.g. ``"--weights"``) and what is wrong.
+
+    Examples
+    --------
+    >>> check_heat_weights("1,0,1"), check_heat_weights([2, 0, 0])
+    ((1.0, 0.0, 1.0), (2.0, 0.0, 0.0))
+    """
+    if isinstance(weights, str):
+        try:
+            weights = [float(v) for v in weights.split(",")]
+        except ValueError:
+            raise ParameterError(f"{name} must be three numbers w_t,w_sm,w_sf, got {weights!r}") from None
+    if isinstance(weights, bytes) or not hasattr(weights, "__len__") or len(weights) != 3:
+        raise ParameterError(f"{name} must be three numbers (w_t, w_sm, w_sf), got {reprlib.repr(weights)}")
+    w = tuple(check_real(v, f"{name}[{i}] ({part})", minimum=0.0)
+              for i, (v, part) in enumerate(zip(weights, ("w_t", "w_sm", "w_sf"))))
+    if sum(w) <= 0:
+        raise ParameterError(f"{name} (w_t, w_sm, w_sf) must not all be zero, got {list(w)}")
     return w
 
 
@@ -283,7 +301,7 @@ def heat_fitness(workspace: Workspace, poses, commands, *, t_max: float | None =
     timing = _check_timing(timing)
     poses = _check_poses(poses)
     commands = _check_commands(commands, len(poses) - 1)
-    w = _check_weights(weights)
+    w = np.array(check_heat_weights(weights))
     t_max = (default_t_max(workspace, timing) if t_max is None
              else check_real(t_max, "t_max", minimum=0.0, include_minimum=False))
     l_p = len(commands)

@@ -578,6 +578,11 @@ def _table7_md(rows: list[dict]) -> list[str]:
     if total:
         out.append(f"- heat f ≥ GA mean f on {wins} of {total} (map, row) cells"
                    + (f"; not on {', '.join(losses)}" if losses else "") + f"; ≥ every GA run's f on {every} of {total}.")
+        if losses:
+            out.append("- why the GA can win a row: eqs. 10 and 11 divide by the path's own length, so a longer path "
+                       "with as many changes of command (or more safe poses) scores higher; the heat planner sums "
+                       "over a fixed length and never pads, the GA's chromosomes do (its paths are slower: see the "
+                       "time row).")
     if speed:
         low, high = min(s[3] for s in speed), max(s[3] for s in speed)
         out.append(f"- speed: the GA takes {low:.0f}–{high:.0f}× the heat planner's time per plan ("

@@ -284,27 +284,16 @@ def _check_start(value, name: str) -> int | str:
 
 
 def _check_heat_weights(value, name: str) -> list[float]:
-    """Eq. 12's (w_t, w_sm, w_sf): three finite numbers ≥ 0, not all zero (a list, or "1,0,0")."""
-    if isinstance(value, str):  # as the command line's "--weights 1,1,1"
-        try:
-            value = [float(v) for v in value.split(",")]
-        except ValueError:
-            raise ParameterError(f"{name} must be three numbers w_t,w_sm,w_sf, got {value!r}") from None
-    if not isinstance(value, (list, tuple)) or len(value) != 3:
-        raise ParameterError(f"{name} must be three numbers [w_t, w_sm, w_sf] (a list, or 'w_t,w_sm,w_sf'), "
-                             f"got {value!r}")
-    values = [check_real(v, f"{name}[{i}]", minimum=0.0) for i, v in enumerate(value)]
-    if sum(values) <= 0:
-        raise ParameterError(f"{name} (w_t, w_sm, w_sf) must not all be zero, got {values}")
-    return values
+    from htetro_opt.problems.heat_costs import check_heat_weights  # the one check; heavy imports stay lazy
 
-
-_HEAT_ELEMENTS = ("q1", "p0")  # solve_heat_field's elements (the planner's module keeps them private)
+    return list(check_heat_weights(value, name))
 
 
 def _check_element(value, name: str) -> str:
-    if not isinstance(value, str) or value not in _HEAT_ELEMENTS:
-        raise ParameterError(f"{name} must be one of {', '.join(_HEAT_ELEMENTS)} (the heat field's element), "
+    from htetro_opt.solvers.grid_paths import HEAT_ELEMENTS
+
+    if not isinstance(value, str) or value not in HEAT_ELEMENTS:
+        raise ParameterError(f"{name} must be one of {', '.join(HEAT_ELEMENTS)} (the heat field's element), "
                              f"got {value!r}")
     return value
 

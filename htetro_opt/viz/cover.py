@@ -48,7 +48,9 @@ def _check_plan(plan, workspace=None):
 
 def _layer_keys(names) -> list[tuple[str, int, int, str]]:
     """(name, state, heading, colour) of each layer name of a plan (``O``, ``vI``, ``hI``, ``SHAPE@H``)."""
-    from htetro_opt.solvers.coverage import parse_layers  # the one reading of layer names
+    from htetro_opt.solvers.coverage import (
+        parse_layers,  # the one reading of layer names
+    )
 
     return [(layer.name, shape_index(layer.shape), layer.heading,
              LAYER_COLOURS.get(layer.name, SHAPE_COLOURS[layer.shape])) for layer in parse_layers(list(names))]

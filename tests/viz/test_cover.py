@@ -11,8 +11,8 @@ from htetro_opt.solvers.coverage import plan_coverage
 from htetro_opt.viz import LAYER_COLOURS, plot_cover, plot_cover_heat, save_figure
 
 matplotlib.use("Agg")  # before pyplot is first imported (htetro_opt.viz imports it lazily)
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.colors import to_rgba  # noqa: E402
+import matplotlib.pyplot as plt
+from matplotlib.colors import to_rgba
 
 # (state, heading) of the paper's layers: I is state 0, O state 1
 KEYS = {"O": (1, 0), "vI": (0, 0), "hI": (0, 3)}

@@ -20,7 +20,11 @@ from scipy.sparse.csgraph import breadth_first_order
 
 from htetro_opt.errors import ConfigurationError, PlanningError
 from htetro_opt.model.commands import COMMANDS, parse_commands
-from htetro_opt.model.coverage import CoverageResult, grid_activity, simulate_command_coverage
+from htetro_opt.model.coverage import (
+    CoverageResult,
+    grid_activity,
+    simulate_command_coverage,
+)
 from htetro_opt.model.robot import FOOTPRINTS, Pose, as_pose
 from htetro_opt.model.workspace import Workspace
 from htetro_opt.solvers.coverage._layers import LayerGraph

@@ -21,7 +21,7 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "Plan": "._result", "FrontMember": "._result", "LegResult": "._result",
     "plan_exact": "._exact", "EXACT_METHODS": "._exact",
     "plan_ga": "._ga",
-    "plan_heat": "._heat",
+    "plan_heat": "._heat", "HEAT_ENGINES": "._heat", "BAND_SEEDS": "._heat",
     "replan_heat": "._replan", "HeatRun": "._replan",
-    "solve_heat_field": "._heat_field", "HeatField": "._heat_field",
+    "solve_heat_field": "._heat_field", "HeatField": "._heat_field", "HEAT_ELEMENTS": "._heat_field",
 })

@@ -22,7 +22,10 @@ with ``s`` Fig. 5's safety penalty of a pose (:func:`~htetro_opt.problems.heat_c
 the number of commands of the leg's time-only constrained plan (the paper's ``1/l_p`` with the length
 fixed, so the cost stays a sum over edges); the last term breaks ties towards the faster plan.
 Minimising Σ s / L is not minimising eq. 11's mean exactly (a plan with fewer commands divides by
-less); the plan's ``info["fitness"]`` reports the exact eqs. 9–12. With w_sm > 0 the last command
+less); the plan's ``info["fitness"]`` reports the exact eqs. 9–12. Eqs. 10 and 11 are ratios over
+the plan's own length, so padding a path with repeated commands or safe detours raises them without
+end (four ``r+`` in place add commands and no change); with L fixed the search cannot pad, and a
+method that does (a GA's longer chromosomes) can score a higher f_sm or f_sf on a slower path. With w_sm > 0 the last command
 becomes part of the search state: one layer of poses per repeatable command (translations and
 rotations; a shapeshift cannot repeat) and a hub layer, entered at no cost from every layer, whose
 commands pay the change ``w_sm / L`` — a repeat inside a layer does not.
@@ -47,7 +50,7 @@ import time as _time
 from collections.abc import Mapping
 from dataclasses import replace
 from types import SimpleNamespace
-from typing import Sequence
+from typing import NamedTuple, Sequence
 
 import numpy as np
 from scipy.ndimage import maximum_filter
@@ -63,7 +66,7 @@ from htetro_opt.model.robot import as_pose, shape_index
 from htetro_opt.model.simulate import Simulator, check_memory, table_shape, transitions_at
 from htetro_opt.model.sweeps import sweep_tables
 from htetro_opt.model.workspace import Workspace, describe_cells, grid_distance
-from htetro_opt.problems.heat_costs import default_t_max, heat_fitness, safety_pattern
+from htetro_opt.problems.heat_costs import check_heat_weights, default_t_max, heat_fitness, safety_pattern
 from htetro_opt.solvers.grid_paths._exact import _GRAPH_BYTES, _check_memory, _Graph
 from htetro_opt.solvers.grid_paths._heat_field import HEAT_ELEMENTS, solve_heat_field
 from htetro_opt.solvers.grid_paths._result import Plan, check_map, check_roadmap, finish_plan, prepare
@@ -86,16 +89,6 @@ _FIELD_OPTIONS = ("k_obstacle", "split_pinches", "solver", "tol")
 _TIE_BREAK = 1e-9
 _MOVES = ("translation", "diagonal")
 _TABLE_BYTES = 8 + 1 + 8  # per (pose, command) of a band: targets (int64), usable mask, weights
-
-
-def _check_weights(weights) -> tuple[float, float, float]:
-    if isinstance(weights, (str, bytes)) or not hasattr(weights, "__len__") or len(weights) != 3:
-        raise ParameterError(f"weights must be three numbers (w_t, w_sm, w_sf), got {reprlib.repr(weights)}")
-    w = tuple(check_real(v, f"weights[{i}] ({name})", minimum=0.0)
-              for i, (v, name) in enumerate(zip(weights, ("w_t", "w_sm", "w_sf"))))
-    if sum(w) <= 0:
-        raise ParameterError(f"weights (w_t, w_sm, w_sf) must not all be zero, got {list(w)}")
-    return w
 
 
 def _check_band(band) -> str | int:
@@ -443,6 +436,7 @@ def plan_heat(
         Method ``"heat"``; ``reached`` is False (not an exception) when a leg has no path at all.
         ``info`` (JSON-ready but for ``fields``): ``weights``, ``t_max``, and per solved leg
         ``relaxed`` (no monotone path: the unconstrained one taken), ``surrogate`` (the J minimised),
+        ``length`` (its L),
         ``band`` (``radius`` (None = whole graph), ``cells``, ``seed``: ``"ascent"``,
         ``"grid_distance"`` or None); per leg ``field`` (``element``, ``dofs``, ``solver``,
         ``iterations``, ``seconds``); ``fitness`` (:func:`~htetro_opt.problems.heat_costs.heat_fitness`
@@ -465,7 +459,7 @@ def plan_heat(
     >>> plan.reached, round(plan.time, 3), plan.tokens, plan.info["relaxed"]
     (True, 2.828, ['x+y+', 'x+y+'], [False])
     """
-    w = _check_weights(weights)
+    w = check_heat_weights(weights)
     monotone = check_bool(monotone, "monotone")
     keep_fields = check_bool(keep_fields, "keep_fields")
     band = _check_band(band)
@@ -521,18 +515,20 @@ def plan_heat(
             mask = ~moves[None, :] | (there >= here - field.epsilon)
         timed = _LegSearch(space, mask, time_cost + tie, 0.0, engine).run(a, b)
         if timed is None or (w[1] == 0 and w[2] == 0):
-            return timed
+            return None if timed is None else (*timed, len(timed[0]))
         length = max(len(timed[0]), 1)
         cost = w[0] * time_cost / sum(w) + tie
         if space.safety is not None:
             cost = cost + w[2] * space.safety[np.minimum(target, n - 1)] / (length * sum(w))
-        return _LegSearch(space, mask, cost, w[1] / (length * sum(w)), engine).run(a, b)
+        steps, surrogate = _LegSearch(space, mask, cost, w[1] / (length * sum(w)), engine).run(a, b)
+        return steps, surrogate, length
 
     commands_out: list[int] = []
     poses_out = [np.asarray(rows[0], dtype=np.int64)[None]]
     leg_ends: list[int] = []
     relaxed: list[bool] = []
     surrogate: list[float] = []
+    lengths: list[int] = []
     bands: list[dict] = []
     records: list[dict] = []
     fields = []
@@ -549,8 +545,8 @@ def plan_heat(
         records.append(record)
         rule = field if monotone and field is not None and field.connected else None
         if (a_row == b_row).all():
-            found, leg_band = ([], 0.0, False, np.empty((0, 4), dtype=np.int64)), {"radius": radius, "cells": 0,
-                                                                                   "seed": None}
+            found = _LegPlan([], 0.0, 0, False, np.empty((0, 4), dtype=np.int64))
+            leg_band = {"radius": radius, "cells": 0, "seed": None}
         elif whole:
             found = _relaxed(search, space, space.pose_id(a_row), space.pose_id(b_row), rule, monotone)
             leg_band = {"radius": None, "cells": ws.width * ws.height, "seed": None}
@@ -561,14 +557,14 @@ def plan_heat(
         if found is None:
             failed = leg
             break
-        steps, cost, leg_relaxed, leg_rows = found
-        relaxed.append(leg_relaxed)
-        surrogate.append(cost)
-        commands_out.extend(steps)
-        poses_out.append(leg_rows)
+        relaxed.append(found.relaxed)
+        surrogate.append(found.surrogate)
+        lengths.append(found.length)
+        commands_out.extend(found.commands)
+        poses_out.append(found.rows)
         leg_ends.append(len(commands_out))
     info = {"weights": list(w), "t_max": float(t_max), "relaxed": relaxed, "surrogate": surrogate,
-            "band": bands, "field": records}
+            "length": lengths, "band": bands, "field": records}
     if keep_fields:
         info["fields"] = fields
     global_ids = np.array(commands_out, dtype=np.int64)
@@ -582,17 +578,26 @@ def plan_heat(
     return replace(plan, info={**plan.info, "fitness": fitness})
 
 
-def _relaxed(search, space: _Space, a: int, b: int, rule, monotone: bool):
-    """The leg under the field's rule, else unconstrained (flagged relaxed when the rule was asked
-    for): global command ids, J, relaxed, poses after each command."""
+class _LegPlan(NamedTuple):
+    commands: list[int]  # global command ids
+    surrogate: float  # the J minimised
+    length: int  # the L of J's smoothness and safety terms
+    relaxed: bool
+    rows: np.ndarray  # (x, y, state, heading) after each command
+
+
+def _leg_plan(space: _Space, a: int, found, relaxed: bool) -> _LegPlan:
+    steps, surrogate, length = found
+    return _LegPlan([int(space.sim.command_ids[s]) for s in steps], surrogate, length, relaxed, space.rows(a, steps))
+
+
+def _relaxed(search, space: _Space, a: int, b: int, rule, monotone: bool) -> _LegPlan | None:
+    """The leg under the field's rule, else unconstrained (flagged relaxed when the rule was asked for)."""
     found = search(space, a, b, rule) if rule is not None else None
     leg_relaxed = False
     if found is None:
         found, leg_relaxed = search(space, a, b, None), monotone
-    if found is None:
-        return None
-    steps, cost = found
-    return [int(space.sim.command_ids[s]) for s in steps], cost, leg_relaxed, space.rows(a, steps)
+    return None if found is None else _leg_plan(space, a, found, leg_relaxed)
 
 
 def _pose_name(i: int, n: int) -> str:
@@ -641,12 +646,11 @@ def _band_search(search, ws: Workspace, a_row, b_row, field, rule, monotone: boo
         a, b = space.pose_id(a_row), space.pose_id(b_row)
         found = search(space, a, b, rule) if rule is not None else None
         if found is not None:
-            return ([int(space.sim.command_ids[s]) for s in found[0]], found[1], False, space.rows(a, found[0])), record
+            return _leg_plan(space, a, found, False), record
         if len(cells) == n_free or rule is None:  # the whole map, or no rule to widen for
             found = search(space, a, b, None)
             if found is not None or len(cells) == n_free:
-                return (None if found is None else ([int(space.sim.command_ids[s]) for s in found[0]], found[1],
-                                                    monotone, space.rows(a, found[0]))), record
+                return (None if found is None else _leg_plan(space, a, found, monotone)), record
         r *= 2
 
 

@@ -207,7 +207,7 @@ def test_plans_are_valid_and_cover_every_coverable_cell(ws, data):
         some_fit = any(fits(ws, l.pose(px, py)) and (l.pose(px, py).cells() == (x, y)).all(axis=1).any()
                        for l in used for px in range(x - 3, x + 4) for py in range(y - 3, y + 4))
         assert reason == ("unreachable" if some_fit else "no-fit")
-    if method == "stripes":
+    if method in ("stripes", "stripes-paper"):
         assert plan.dag_cost is None or \
             plan.action_cost == plan.dag_cost + plan.transit_commands + plan.mopup_commands
 
@@ -334,3 +334,28 @@ def test_a_layer_cut_off_at_the_top_edge_is_still_entered():
     both = plan_coverage(ws, "O,vI")
     assert alone.action_cost == 26 == both.action_cost - 2  # + the O -> vI switch at the start
     assert both.stripes_detail[-1]["cost"] == alone.stripes_detail[-1]["cost"] == 11
+
+
+def test_paper_variant_cuts_at_forced_poses():
+    # a pocket above the lane: O at (2, 3) is the only pose covering it, and O at (6, 1) the only one
+    # covering column 7; the paper's simple paths reach both through cuts at those forced poses
+    ws = Workspace(np.array([[c == "#" for c in row] for row in ("##..####", "##..####", "........",
+                                                                  "........")][::-1]))
+    paper = plan_coverage(ws, "O", method="stripes-paper")
+    ours = plan_coverage(ws, "O")
+    assert paper.complete and ours.complete and paper.action_cost == ours.action_cost == 10
+    assert paper.stripes_detail[0]["cuts"] == [2, 6] and paper.method == "stripes-paper"
+    again = plan_coverage(ws, "O", method="stripes-paper", memo=False)
+    assert again.tokens == paper.tokens
+
+
+def test_tiling_tsp_baseline():
+    ws = empty(8, 4)
+    plan = plan_coverage(ws, "O", method="tiling-tsp")
+    assert plan.complete and plan.info["tiles"] == 8 and plan.action_cost >= 14
+    run = Simulator(ws, commands=SEED004_COMMANDS).run([plan.commands], plan.start)
+    assert run.valid[0] and run.time[0] == plan.time
+    goal = Pose(2, 3, "O", 0)
+    assert plan_coverage(ws, "O", method="tiling-tsp", goal=goal).poses[-1].tolist() == [2, 3, 1, 0]
+    with pytest.raises(TilingError):
+        plan_coverage(empty(6, 3), "O", method="tiling-tsp", stripes=3)  # 18 cells

@@ -11,8 +11,16 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from htetro_opt.errors import ConfigurationError, ParameterError, UnknownCommandError
-from htetro_opt.model import FOOTPRINTS, SEED004_COMMANDS, Pose, Simulator, Timing, Workspace, parse_commands, \
-    sweep_tables
+from htetro_opt.model import (
+    FOOTPRINTS,
+    SEED004_COMMANDS,
+    Pose,
+    Simulator,
+    Timing,
+    Workspace,
+    parse_commands,
+    sweep_tables,
+)
 from htetro_opt.model.coverage import grid_activity, simulate_command_coverage
 from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers import plan_coverage

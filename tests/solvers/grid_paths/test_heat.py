@@ -189,6 +189,7 @@ def test_each_weighting_minimises_its_own_cost_among_the_table6_plans(name):
     scenario = load_scenario(name)
     plans = {w: plan_heat(scenario.workspace, scenario.roadmap, weights=w) for w in TABLE6}
     length = len(plans[(1.0, 0.0, 0.0)].commands)  # L: the time-only constrained plan's length
+    assert all(p.info["length"] == [length] for p in plans.values())
     assert all(p.reached and p.info["relaxed"] == [False] for p in plans.values())
     for w, plan in plans.items():
         own = _surrogate(scenario.workspace, plan, w, length)
