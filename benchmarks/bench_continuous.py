@@ -11,8 +11,18 @@ run side by side, answers asserted equal.
    networkx's Dijkstra. Target: <= 1 s per map.
 3. A* grid 0.25 on the 50 x 50 maps: the heapq A* over the lattice (graph build included) against
    scipy's csgraph Dijkstra on the same lattice graph. Target: <= 2 s.
+4. The enhanced GA (PS 10, IS 20, APF included) on every map x ``--seeds`` seeds, side by side with
+   the exact optimum and A* at grid 1 and 0.25 run in the same process; EGA as published beside it.
+   Targets: EGA mean length <= 1.005 x exact on every map, shorter than A* 0.25 on 12/12; per run
+   <= 0.5 s on 20 x 20 / 30 x 30 and <= 2 s on 50 x 50. Every plan re-validates, and no length is
+   below the exact lower bound (asserted).
+5. ega_cross4 x ``--seeds`` seeds, the four robots planned jointly by the EGA: every run's closest
+   approach >= d_s, obstacle-free, sum of lengths <= 1.10 x the sum of the robots' own optima.
 
-Run:  python benchmarks/bench_continuous.py [--repeat N]
+6. Our additions to the EGA switched off one at a time (``EnhancedGA(10, refine=False)`` etc.), mean
+   length / exact over ``--ablation-seeds`` seeds per map.
+
+Run:  python benchmarks/bench_continuous.py [--repeat N] [--seeds S] [--ablation-seeds S] [--only 1,2,3,4,5,6]
 """
 
 from __future__ import annotations
@@ -162,13 +172,114 @@ def bench_astar(repeat):
     print()
 
 
+def bench_ega(seeds):
+    print(f"## 4. Enhanced GA (PS 10, IS 20) beside exact and A*, {seeds} seeds per map\n")
+    print("| map | exact | A* 1 | A* 0.25 | EGA mean ± std | EGA / exact | EGA < A* 0.25 | EGA s mean (max) "
+          "| EGA-paper mean | EGA-paper / exact | EGA-paper s mean |")
+    print("|---|---:|---:|---:|---:|---:|:---:|---:|---:|---:|---:|")
+    within, shorter, paper_shorter, slow = 0, 0, 0, []
+    names = [n for n in list_scenarios() if n.startswith("ega") and n != "ega_cross4"]
+    for method in ("ega", "ega-paper"):  # the first run imports pymoo, scipy.interpolate and the GA: not timed
+        plan_continuous(load_scenario("ega07_slits1"), method=method, seed=0, max_gen=1)
+    for name in names:
+        scenario = load_scenario(name)
+        exact = plan_continuous(scenario)
+        lower = exact.info["lower_bound"][0]
+        a1 = plan_continuous(scenario, method="astar", grid=1.0).lengths[0]
+        a25 = plan_continuous(scenario, method="astar", grid=0.25).lengths[0]
+        runs = {}
+        for method in ("ega", "ega-paper"):
+            lengths, times = [], []
+            for seed in range(seeds):
+                plan = plan_continuous(scenario, method=method, seed=seed)
+                assert plan.reached and all(plan.feasible), (name, method, seed)
+                assert plan.lengths[0] >= lower - 1e-9, (name, method, seed, plan.lengths[0], lower)
+                lengths.append(plan.lengths[0])
+                times.append(plan.runtime_s)
+            runs[method] = (np.array(lengths), np.array(times))
+        (ega, t_ega), (paper, t_paper) = runs["ega"], runs["ega-paper"]
+        ratio = ega.mean() / exact.lengths[0]
+        within += ratio <= 1.005
+        shorter += ega.mean() < a25
+        paper_shorter += paper.mean() < a25
+        limit = 2.0 if scenario.width >= 50 else 0.5
+        if t_ega.max() > limit:
+            slow.append(f"{name} {t_ega.max():.2f} s")
+        print(f"| {name} | {exact.lengths[0]:.2f} | {a1:.2f} | {a25:.2f} | {ega.mean():.2f} ± {ega.std():.2f} "
+              f"| {ratio:.4f} | {'yes' if ega.mean() < a25 else 'no'} | {t_ega.mean():.2f} ({t_ega.max():.2f}) "
+              f"| {paper.mean():.2f} | {paper.mean() / exact.lengths[0]:.4f} | {t_paper.mean():.2f} |")
+    print(f"\nEGA within 1.005 x exact on {within}/{len(names)} maps, shorter than A* 0.25 on {shorter}/{len(names)}; "
+          f"EGA-paper shorter than A* 0.25 on {paper_shorter}/{len(names)}; runs over the time target: "
+          f"{', '.join(slow) or 'none'}\n")
+
+
+def bench_cross4(seeds):
+    print(f"## 5. ega_cross4, four robots planned jointly by the EGA, {seeds} seeds\n")
+    scenario = load_scenario("ega_cross4")
+    alone = plan_continuous(scenario)
+    own = alone.lengths.sum()
+    closest, ratios, times = [], [], []
+    for seed in range(seeds):
+        plan = plan_continuous(scenario, method="ega", seed=seed)
+        assert plan.reached and all(plan.feasible)
+        closest.append(plan.min_robot_distance)
+        ratios.append(plan.lengths.sum() / own)
+        times.append(plan.runtime_s)
+    closest, ratios, times = map(np.array, (closest, ratios, times))
+    print("| planned | closest approach min (mean) | d_s | runs >= d_s | sum of lengths / own optima, max (mean) "
+          "| s mean (max) |")
+    print("|---|---:|---:|---:|---:|---:|")
+    print(f"| each alone (exact) | {alone.min_robot_distance:.3f} | {alone.safety_distance:g} | - | 1.0000 | "
+          f"{alone.runtime_s:.2f} |")
+    print(f"| jointly (EGA) | {closest.min():.3f} ({closest.mean():.3f}) | {alone.safety_distance:g} "
+          f"| {int((closest >= alone.safety_distance).sum())}/{seeds} | {ratios.max():.4f} ({ratios.mean():.4f}) "
+          f"| {times.mean():.2f} ({times.max():.2f}) |")
+    print()
+
+
+def bench_ablation(seeds):
+    from pymoo.optimize import minimize
+
+    from htetro_opt.algorithms import EnhancedGA
+    from htetro_opt.problems import PathBasesProblem
+
+    print(f"## 6. EGA / exact with one addition off, {seeds} seeds per map\n")
+    variants = {"all on": {}, "no refine": {"refine": False}, "no finer APF": {"finer_apf": False},
+                "no child deletion": {"delete_children": False}}
+    print("| map | " + " | ".join(variants) + " |")
+    print("|---|" + "---:|" * len(variants))
+    for name in [n for n in list_scenarios() if n.startswith("ega") and n != "ega_cross4"]:
+        scenario = load_scenario(name)
+        exact = plan_continuous(scenario).lengths[0]
+        row = []
+        for options in variants.values():
+            best = [minimize(PathBasesProblem(scenario), EnhancedGA(10, **options), ("n_gen", 21),
+                             seed=seed).algorithm.history[-1] for seed in range(seeds)]
+            row.append(f"{np.mean(best) / exact:.4f}")
+        print(f"| {name} | " + " | ".join(row) + " |")
+    print()
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--seeds", type=int, default=10)
+    parser.add_argument("--ablation-seeds", type=int, default=5)
+    parser.add_argument("--only", default="1,2,3,4,5,6", help="sections to run, e.g. 4,5")
     args = parser.parse_args()
-    bench_population(args.repeat)
-    bench_exact(args.repeat)
-    bench_astar(args.repeat)
+    only = {int(k) for k in args.only.split(",")}
+    if 1 in only:
+        bench_population(args.repeat)
+    if 2 in only:
+        bench_exact(args.repeat)
+    if 3 in only:
+        bench_astar(args.repeat)
+    if 4 in only:
+        bench_ega(args.seeds)
+    if 5 in only:
+        bench_cross4(args.seeds)
+    if 6 in only:
+        bench_ablation(args.ablation_seeds)
 
 
 if __name__ == "__main__":

@@ -8,7 +8,10 @@ the same cells. A second table runs every method (stripes, stripes-paper, boustr
 on the 16 x 16 map with the command-driven coverage metrics.
 
     python benchmarks/bench_cover.py            # the issue's targets
-    python benchmarks/bench_cover.py --quick    # the 16 x 16 rows only
+    python benchmarks/bench_cover.py --quick    # the 16 x 16 and 16 x 7 rows only
+
+The indoor room's {O} rows start at the roadmap's start (its goal lies behind a doorway the O cannot
+pass) or at the bottom-left pose, both with a free end, and their boustrophedon from the same start.
 """
 
 from __future__ import annotations
@@ -34,14 +37,21 @@ CASES = [
     ("coverage_16x7", "O,hI", "2,3,2"),
     ("tiling_64x64", "O", 4),
     ("tiling_64x64", "O,vI,hI", 4),
+    ("indoor_room", "O,vI,hI", 4),  # the roadmap's start and goal, behind the doorway
+    ("indoor_room", "O", 4, "start"),  # the roadmap's start, a free end (the O cannot pass the doorway)
+    ("indoor_room", "O", 4, "auto"),  # the bottom-left pose, a free end
 ]
+LARGE = ("tiling_64x64", "indoor_room")
 
 
-def run(name: str, layers: str, stripes, method: str = "stripes") -> dict:
+def run(name: str, layers: str, stripes, method: str = "stripes", ends: str = "roadmap") -> dict:
+    """One plan; ``ends``: the roadmap's start and goal ("roadmap"), its start and a free end
+    ("start"), or the bottom-left pose and a free end ("auto")."""
     sc = load_scenario(name)
     start = goal = None
-    if sc.roadmap:
-        start, goal = sc.start, sc.goal
+    if sc.roadmap and ends != "auto":
+        start = sc.start
+        goal = sc.goal if ends == "roadmap" else None
     cpu, wall = time.process_time(), time.perf_counter()
     plan = plan_coverage(sc.workspace, layers, method=method, stripes=stripes, start=start, goal=goal)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
@@ -65,17 +75,19 @@ def main() -> None:
           "| DAG nodes / edges | graph vertices / edges | CPU s | wall s |")
     print("|---|---|---|---|---:|---:|---:|---|---:|---|---|---:|---:|")
     baselines: dict = {}
-    for name, layers, stripes in CASES:
-        if args.quick and name == "tiling_64x64":
+    for name, layers, stripes, *ends in CASES:
+        if args.quick and name in LARGE:
             continue
-        r = run(name, layers, stripes)
+        ends = ends[0] if ends else "roadmap"
+        r = run(name, layers, stripes, ends=ends)
         p = r["plan"]
-        if name not in baselines:
-            baselines[name] = run(name, "O", 4, method="boustrophedon")
-        b = baselines[name]["plan"]
-        if p.layers == ("O",):  # the same morphology set covers the same cells
+        key = (name, "start" if ends == "roadmap" and name == "indoor_room" else ends)  # O cannot reach its goal
+        if key not in baselines:
+            baselines[key] = run(name, "O", 4, method="boustrophedon", ends=key[1])
+        b = baselines[key]["plan"]
+        if p.layers == ("O",):  # the same morphology set from the same start covers the same cells
             assert (b.coverable == p.coverable).all() and not (b.coverable & ~b.covered).any()
-        print(f"| {name} | {{{layers}}} | {stripes} | {'yes' if p.complete else 'no'} | {p.action_cost} | {r['bound']} "
+        print(f"| {name}{'' if ends == 'roadmap' else f' ({ends})'} | {{{layers}}} | {stripes} | {'yes' if p.complete else 'no'} | {p.action_cost} | {r['bound']} "
               f"| {b.action_cost} | {p.regions} ({p.regions_optimal} / {p.memo_hits}) | {p.nodes} "
               f"| {p.info.get('dag_nodes')} / {p.info.get('dag_edges')} | {r['nodes_graph']} / {r['edges_graph']} "
               f"| {r['cpu']:.2f} | {r['wall']:.2f} |")
@@ -93,7 +105,7 @@ def main() -> None:
                   f"| {p.average_coverage_time:.3f} | {p.recovered_pct:.1f} | {p.switches} | {p.turns} "
                   f"| {r['wall']:.2f} |")
     print("\nbaseline boustrophedon-O CPU s: "
-          + ", ".join(f"{k} {v['cpu']:.2f}" for k, v in baselines.items()))
+          + ", ".join(f"{k[0]} ({k[1]}) {v['cpu']:.2f}" for k, v in baselines.items()))
     print(f"total {time.perf_counter() - began:.1f} s")
 
 

@@ -47,7 +47,7 @@ __all__ = ["main", "main_entry", "build_parser"]
 
 
 EXIT_ERROR = 2
-GA_DEFAULTS = {"pop_size": 50, "max_gen": 1000, "patience": 100, "max_length": None, "seed": 0,
+GA_DEFAULTS = {"pop_size": 50, "max_gen": 1000, "patience": None, "converge": "best", "max_length": None, "seed": 0,
                "replan_window": None, "replan_members": None, "seed_exact": False, "pick": "balanced"}
 """Defaults of ``plan``'s GA options (None in the parser, so that one given to an exact method is refused;
 None here: plan_ga's default for the algorithm)."""
@@ -78,8 +78,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("plan", help="plan a path through a scenario's roadmap")
     p.add_argument("scenario", help="bundled scenario name or path to a scenario TOML file")
-    p.add_argument("--method", choices=PLAN_METHODS, default="dijkstra",
-                   help="dijkstra (default), astar: the minimum-time plan (the same optimum); htetro-ga: the "
+    p.add_argument("--method", choices=(*PLAN_METHODS, *CONTINUOUS_ONLY_METHODS),
+                   help="continuous scenarios (Nazarahari et al. 2019): ega (default): its enhanced GA with our "
+                        "additions, ega-paper: as published, nsga2: pymoo's NSGA-II over the same path bases "
+                        "(--pop-size 10, --max-gen 20 unless given), exact: the visibility-graph optimum, astar: "
+                        "A* on the --grid lattice. Grid scenarios: "
+                        "dijkstra (default), astar: the minimum-time plan (the same optimum); htetro-ga: the "
                         "multi-objective GA over command chromosomes of Cheng et al. 2020 with our additions "
                         "(htetro-ga-paper: as published); nsga2, nsga3, smsemoa, agemoea: pymoo's algorithms "
                         "on the same problem; heat: Do et al. 2021's search up a heat-conduction field "
@@ -89,10 +93,15 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"GA methods: generations per roadmap leg at most (default {GA_DEFAULTS['max_gen']})")
     p.add_argument("--patience", type=int,
                    help="GA methods: stop a leg after this many generations without improvement "
-                        f"once its goal is reached (default {GA_DEFAULTS['patience']})")
+                        "once its goal is reached (default 100); 20 by default with --converge hypervolume")
+    p.add_argument("--converge", choices=("best", "hypervolume"),
+                   help="GA methods: what counts as an improvement for --patience: best (default), a rise of the "
+                        "goal-reaching members' best f_t, f_sm, f_sf or fitness sum; hypervolume, of the best f_t "
+                        "or of their front's hypervolume (half the generations, a slightly smaller front)")
     p.add_argument("--max-length", type=int,
-                   help="GA methods: l_p,max, the initial chromosome length (default, per leg: the larger of 100 "
-                        "and twice the grid distance from the leg's start to its goal)")
+                   help="GA methods: l_p,max, the initial chromosome length (default, per leg: the least multiple "
+                        "of 100 whose time is at least 1.5 times the leg's exact minimum time, as the paper's 100 "
+                        "and 200 on its maps)")
     p.add_argument("--seed", type=int,
                    help=f"GA methods: random seed, the same seed giving the same plan (default {GA_DEFAULTS['seed']})")
     p.add_argument("--replan-window", type=int, metavar="W",
@@ -109,7 +118,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "fitnesses), or the best f_t, f_sm or f_sf")
     p.add_argument("--diagonals", action="store_true", help="dijkstra, astar: allow diagonal translations")
     p.add_argument("--weights", metavar="WT,WSM,WSF",
-                   help="heat: weights of time, smoothness and safety (default 1,0,0)")
+                   help="heat: weights of time, smoothness and safety (default 1,0,0); continuous ega/ega-paper: "
+                        "W_L,W_S,W_R of eq. 6 (default 1,0,0)")
     p.add_argument("--t-max", type=float, metavar="S",
                    help="heat: t_max of f_t in seconds (default: half an O-shape boustrophedon of the empty map)")
     p.add_argument("--element", choices=HEAT_ELEMENTS,
@@ -122,6 +132,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--sensor-range", type=float, metavar="R",
                    help="heat: run in the true world (hidden obstacles), sensing cells within R cells of the blocks "
                         "and replanning when the plan meets a new obstacle (Do et al. 2021: 6)")
+    p.add_argument("--path", choices=("linear", "spline"),
+                   help="continuous, ega/ega-paper/nsga2: straight between the path bases (default) or a cubic spline")
+    p.add_argument("--normalise", action="store_true", default=None,
+                   help="continuous, ega/ega-paper: weights from three single-term runs (Nazarahari et al. 2019, §5.3) "
+                        "instead of --weights")
+    p.add_argument("--safety", choices=("paper", "min"),
+                   help="continuous, ega/ega-paper/nsga2: eq. 5's sum of the path bases' clearances (paper; ega "
+                        "default) or the smallest clearance along the path (min; nsga2 default)")
+    p.add_argument("--grid", type=float, metavar="D",
+                   help="continuous, ega/ega-paper/nsga2: the APF lattice and the mutations' step; astar: the lattice "
+                        "(default 1)")
+    p.add_argument("--robot-radius", metavar="R|SHAPE",
+                   help="continuous: the robots' radius instead of the scenario's, a number or a morphology letter "
+                        "(the disc around that hTetro footprint, e.g. O)")
     p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block (default 0)")
     _add_outputs(p, plot="a plot of the map and the path", gif="an animated GIF of the plan, step by step")
 
@@ -148,8 +172,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("scenario", help="bundled scenario name or path to a scenario TOML file")
     p.add_argument("--shapes", help="allowed morphologies, e.g. TZ or O (default: all seven, IOLJZST)")
-    p.add_argument("--method", choices=TILING_METHODS, default="backtracking",
-                   help="backtracking: the paper's search (default); cpsat: exact cover with OR-Tools CP-SAT")
+    p.add_argument("--method", choices=TILING_METHODS, default="auto",
+                   help="auto (default): backtracking for a few steps, then CP-SAT band by band, then CP-SAT "
+                        "on the whole map; backtracking: the paper's search; cpsat: exact cover with OR-Tools CP-SAT")
     p.add_argument("--overlap", action="store_true",
                    help="if the map cannot be tiled, cover it by two overlapping sub-workspaces (the paper's Fig. 5)")
     p.add_argument("--shuffle", action="store_true",
@@ -200,9 +225,12 @@ def build_parser() -> argparse.ArgumentParser:
         "(task, scenarios, seeds, [[methods]] with the command's options), every trial recorded to "
         "DIR/NAME.jsonl as it ends, then summarised per scenario and method (mean, std, median, success "
         "rate, gap to the exact reference). 'le2018' re-runs the tables of Le et al. 2018 beside the paper's; "
-        "'do2021' those of Do et al. 2021 (Tables 6-8, Fig. 13; DIR/do2021.md and .csv hold its report).",
+        "'do2021' those of Do et al. 2021 (Tables 6-8, Fig. 13; DIR/do2021.md and .csv hold its report); "
+        "'cheng2019' those of Cheng et al. 2019 (Table 2, the 16 x 7 map, baselines and larger maps, every "
+        "coverage plan beside its lower bound; DIR/cheng2019.md and .csv hold its report).",
     )
-    p.add_argument("study", metavar="NAME|FILE", help="a bundled study name, do2021, le2018, or a study TOML file")
+    p.add_argument("study", metavar="NAME|FILE",
+                   help="a bundled study name, cheng2019, do2021, le2018, or a study TOML file")
     p.add_argument("--executor", choices=("serial", "processes", "dask"), default="processes",
                    help="where trials run: this process, local worker processes (default), or a Dask cluster")
     p.add_argument("--workers", type=int, help="processes / dask: number of workers (default: the local cores)")
@@ -214,6 +242,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--retries", type=int, default=0, help="re-run a failing trial up to N times (default 0)")
     p.add_argument("--time-limit", type=float,
                    help="le2018 only: cap in seconds for each method that takes one (a study file sets its own)")
+    p.add_argument("--figures", action="store_true",
+                   help="cheng2019 only: also save the paper's Figs. 8b, 14 and 15 redrawn as PNGs in DIR (needs --out)")
     _add_outputs(p, json="print one JSON object instead of the summary table")
 
     p = sub.add_parser(
@@ -362,8 +392,112 @@ def _cmd_scenarios(args) -> dict:
     return {"scenarios": rows, "tilesets": tilesets}
 
 
+CONTINUOUS_ONLY_METHODS = ("ega", "ega-paper", "exact")
+"""``plan --method`` names for continuous scenarios only (``astar`` and ``nsga2`` plan both kinds)."""
+_CONTINUOUS_METHODS = ("ega", "ega-paper", "nsga2", "exact", "astar")
+_CONTINUOUS_FLAGS = {"path": "--path", "normalise": "--normalise", "safety": "--safety", "grid": "--grid",
+                     "robot_radius": "--robot-radius"}
+_GRID_FLAGS = {"patience": "--patience", "converge": "--converge", "max_length": "--max-length",
+               "replan_window": "--replan-window", "replan_members": "--replan-members", "seed_exact": "--seed-exact",
+               "pick": "--pick", "diagonals": "--diagonals", "t_max": "--t-max", "element": "--element",
+               "no_monotone": "--no-monotone", "band": "--band", "sensor_range": "--sensor-range", "gif": "--gif"}
+
+
+def _only_for(args, flags: dict, where: str) -> None:
+    """Refuse the options of ``flags`` (attribute → flag) that were given: they apply ``where`` only."""
+    given = [flag for name, flag in flags.items() if getattr(args, name, None) not in (None, False)]
+    if given:
+        raise ParameterError(f"{', '.join(given)} {'applies' if len(given) == 1 else 'apply'} to {where} only")
+
+
+def _continuous_weights(text: str) -> tuple[float, float, float]:
+    """``--weights W_L,W_S,W_R`` of eq. 6, each error naming the option."""
+    from htetro_opt.problems import check_path_weights
+
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        raise ParameterError(f"--weights must be three comma-separated numbers W_L,W_S,W_R, got {text!r}") from None
+    return check_path_weights(values, "--weights")
+
+
+def _cmd_plan_continuous(scenario, args) -> dict:
+    """``plan`` on a continuous scenario: one of :data:`_CONTINUOUS_METHODS`, every robot."""
+    from htetro_opt.solvers.continuous import plan_continuous
+
+    _only_for(args, _GRID_FLAGS, "grid scenarios")
+    if args.clearance:
+        raise ParameterError("--clearance applies to grid scenarios only (give a continuous scenario's robots "
+                             "a --robot-radius)")
+    method = args.method or "ega"
+    if method not in _CONTINUOUS_METHODS:
+        raise ParameterError(f"--method {method} plans grid scenarios; {scenario.name!r} is continuous: use one of "
+                             f"{', '.join(_CONTINUOUS_METHODS)}")
+    _outputs(args, ("plot", "plot"))
+    if args.robot_radius is not None:
+        try:
+            radius = float(args.robot_radius)
+        except ValueError:
+            radius = args.robot_radius  # a morphology letter
+        scenario = scenario.with_robot_radius(radius)
+    genetic = method in ("ega", "ega-paper", "nsga2")
+    options = {}
+    if args.grid is not None:
+        options["grid"] = check_real(args.grid, "--grid", minimum=0.0, include_minimum=False,
+                                     maximum=min(scenario.width, scenario.height) / 2)
+    if genetic:
+        options.update(pop_size=check_int(10 if args.pop_size is None else args.pop_size, "--pop-size", minimum=2),
+                       max_gen=check_int(20 if args.max_gen is None else args.max_gen, "--max-gen", minimum=0),
+                       seed=check_int(0 if args.seed is None else args.seed, "--seed", minimum=0))
+        for name in ("path", "safety"):
+            if getattr(args, name) is not None:
+                options[name] = getattr(args, name)
+        if method != "nsga2":
+            if args.weights is not None and args.normalise:
+                raise ParameterError("give --weights or --normalise, not both")
+            if args.weights is not None:
+                options["weights"] = _continuous_weights(args.weights)
+            options["normalise"] = bool(args.normalise)
+        else:
+            _only_for(args, {"weights": "--weights", "normalise": "--normalise"}, "--method ega and ega-paper")
+    else:
+        given = {"pop_size": "--pop-size", "max_gen": "--max-gen", "seed": "--seed", "path": "--path",
+                 "safety": "--safety", "weights": "--weights", "normalise": "--normalise"}
+        _only_for(args, given, "the GA methods (ega, ega-paper, nsga2)")
+        if method == "exact" and args.grid is not None:
+            raise ParameterError("--grid applies to --method astar and the GA methods, not to exact")
+    console = _console(args)
+    with console.step(f"planning ({method})"):
+        plan = plan_continuous(scenario, method=method, **options)
+    out = plan.as_dict()
+    out["runtime_s"] = round(plan.runtime_s, 6)
+    if method == "nsga2":
+        out["front"] = out["info"].pop("front")
+    if args.plot:
+        from htetro_opt.viz import plot_continuous
+
+        status = "reached" if plan.reached else "NOT reached"
+        title = f"{scenario.name}: {method}, length {plan.length:.2f}, {status}"
+        _late(out, lambda: _save_plot(console, lambda: plot_continuous(scenario, plan, title=title), args.plot))
+    if not args.json:
+        status = "reached" if plan.reached else "NOT reached: " + ", ".join(
+            f"robot {k}" for k, ok in enumerate(plan.robots_reached) if not ok)
+        closest = "" if plan.min_robot_distance is None else (
+            f"; closest approach {plan.min_robot_distance:.3f} (d_s {plan.safety_distance:g}, "
+            f"{len(plan.conflicts)} conflict(s))")
+        print(f"{scenario.name}: {status} ({method}, {plan.runtime_s:.3f} s); length {plan.length:.3f}, "
+              f"smoothness {np.nansum(plan.smoothness_deg):.1f} deg{closest}")
+    return out
+
+
 def _cmd_plan(args) -> dict:
-    scenario = _grid_scenario(args.scenario)
+    scenario = load_scenario(args.scenario)
+    if not isinstance(scenario, Scenario):  # Nazarahari et al. 2019's continuous workspaces
+        return _cmd_plan_continuous(scenario, args)
+    _only_for(args, _CONTINUOUS_FLAGS, "continuous scenarios")
+    if args.method in CONTINUOUS_ONLY_METHODS:
+        raise ParameterError(f"--method {args.method} plans continuous scenarios; {scenario.name!r} is a grid scenario")
+    args.method = args.method or "dijkstra"
     clearance = _check_clearance(args.clearance)
     _outputs(args, ("plot", "plot"), ("gif", "animation"))
     if scenario.goal is None:
@@ -401,7 +535,8 @@ def _cmd_plan(args) -> dict:
             setattr(args, name, given.get(name, default))
         options = dict(pop_size=check_int(args.pop_size, "--pop-size", minimum=2),
                        max_gen=check_int(args.max_gen, "--max-gen", minimum=1),
-                       patience=check_int(args.patience, "--patience", minimum=1),
+                       patience=check_int(args.patience, "--patience", minimum=1, allow_none=True),
+                       convergence=args.converge,
                        max_length=check_int(args.max_length, "--max-length", minimum=1, allow_none=True),
                        seed=check_int(args.seed, "--seed", minimum=0),
                        seed_exact=bool(args.seed_exact), pick=args.pick)
@@ -820,6 +955,8 @@ def _study_folder(out: str | None) -> Path | None:
 
 def _cmd_study(args) -> dict:
     if args.study == "le2018":
+        if args.figures:
+            raise ParameterError("--figures applies to cheng2019 only, not to study 'le2018'")
         return _le2018(args)
     from htetro_opt.studies.runner import load_study, run_study
 
@@ -834,6 +971,10 @@ def _cmd_study(args) -> dict:
     workers = check_int(args.workers, "--workers", minimum=1, allow_none=True)
     retries = check_int(args.retries, "--retries", minimum=0)
     out = _study_folder(args.out)
+    if study.name == "cheng2019":  # Cheng et al. 2019: its report beside the paper's, figures on request
+        return _cheng2019(args, study, seeds, workers, retries, out)
+    if args.figures:
+        raise ParameterError(f"--figures applies to cheng2019 only, not to study {study.name!r}")
     if study.name == "do2021":  # Do et al. 2021: Tables 6-7 on the runner, Table 8 and Fig. 13 beside them
         return _do2021(args, study, seeds, workers, retries, out)
     # Table 4 of Cheng et al. 2020 records the paper's own measures, and its report sets them beside the paper's
@@ -878,6 +1019,49 @@ def _do2021(args, study, seeds, workers, retries, out) -> dict:
         _late(result, lambda: do2021.write_report(out, run, table8=table8, fig13=fig13))
     if not args.json:
         print(do2021.report(run, table8=table8, fig13=fig13), end="")
+        if run.path is not None:
+            print(f"\n{len(run.records)} trials ({run.failed} failed) recorded in {run.path}")
+    return result
+
+
+def _cheng2019(args, study, seeds, workers, retries, out) -> dict:
+    """Cheng et al. 2019's study beside the paper's: every trial on the study runner (the bundled study,
+    or a study file named cheng2019); DIR/cheng2019.md and .csv hold the report, and with --figures
+    DIR/cheng2019_fig*.png the paper's Figs. 8b, 14 and 15 redrawn."""
+    from htetro_opt.studies import cheng2019
+
+    if seeds is not None:
+        raise ParameterError("--seeds does not apply to cheng2019: every coverage method is deterministic")
+    if args.figures and out is None:
+        raise ParameterError("--figures needs --out DIR, the folder the figures are saved in")
+    console = _console(args)
+    with console.step("cheng2019 study", 1, "trials") as progress:
+        run = cheng2019.run_cheng2019(study=study, executor=args.executor, workers=workers, scheduler=args.scheduler,
+                                      out=out, resume=args.resume, retries=retries, progress=progress)
+    if run.dashboard and not args.quiet:
+        print(f"dask dashboard: {run.dashboard}", file=sys.stderr)
+    figures: dict[str, str] = {}
+    result = {**run.as_dict(), "figures": figures}
+    if args.figures:
+        from htetro_opt.viz import plot_cover, plot_cover_heat
+
+        for name, (workspace, plan, title) in cheng2019.figure_plans().items():
+            def path_plot(workspace=workspace, plan=plan, title=title):
+                return plot_cover(workspace, plan, title=title)
+
+            def heat_plot(plan=plan, title=title):
+                return plot_cover_heat(plan, title=title)
+
+            # Fig. 8b is a plan; Figs. 14 and 15 a plan (a) and its coverage times (b, c)
+            drawings = {name: path_plot} if name == "fig8b" else {f"{name}a": path_plot, f"{name}bc": heat_plot}
+            for figure, draw in drawings.items():
+                path = f"cheng2019_{figure}.png"
+                _late(result, lambda draw=draw, path=path: _save_plot(console, draw, str(out / path)))
+                figures[figure] = path
+    if out is not None:
+        _late(result, lambda: cheng2019.write_report(out, run, figures=figures))
+    if not args.json:
+        print(cheng2019.report(run, figures=figures), end="")
         if run.path is not None:
             print(f"\n{len(run.records)} trials ({run.failed} failed) recorded in {run.path}")
     return result

@@ -1050,9 +1050,13 @@ def test_cover_json_keys_and_replay(capsys):
     assert out["average_coverage_time"] == pytest.approx(4 * out["time"] / out["free"], rel=0.01)
     assert out["complete"] is False and out["uncoverable"] == [{"x": 0, "y": 0, "reason": "no-fit"}]
     assert out["covered"] == out["coverable"] == out["free"] - 1 and out["action_cost"] == len(out["commands"])
-    assert out["stripes"] == [2, 3, 2] and out["stripes_detail"][-1]["borrowed"] >= 1
+    assert out["stripes"] == [2, 3, 2] and len(out["stripes_detail"]) == 3
     replay = run_json(capsys, ["simulate", "coverage_16x7", "--commands", ",".join(out["commands"]), "--json"])
     assert replay["valid"] is True and replay["time"] == pytest.approx(out["time"])
+    paper = run_json(capsys, ["cover", "coverage_16x7", "--shapes", "O,hI", "--stripes", "2,3,2", "--method",
+                              "stripes-paper", "--json"])
+    assert paper["stripes_detail"][-1]["borrowed"] >= 1  # the paper's Fig. 11: the top stripe borrows a row
+    assert out["action_cost"] <= paper["action_cost"]
 
 
 def test_cover_boustrophedon_and_auto_start(capsys):

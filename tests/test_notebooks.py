@@ -22,7 +22,9 @@ NOTEBOOKS = sorted(NOTEBOOK_DIR.glob("*.ipynb"))
 PAPERS = {
     "00_quickstart.ipynb": "Cheng et al. 2020",
     "01_htetro_ga_pareto.ipynb": "Cheng et al. 2020",
+    "02_heat_conduction.ipynb": "Do et al. 2021",
     "04_tiling_sequencing.ipynb": "Le et al. 2018",
+    "05_stripe_coverage.ipynb": "Cheng et al. 2019",
 }
 AUTHORS_AND_YEAR = re.compile(r"\b[A-Z][a-z]+ et al\. (19|20)\d\d\b")
 # "seed 0", "seed 000", "seed 003", "seed003", "SEED000_…": internal names of the papers' work packages.

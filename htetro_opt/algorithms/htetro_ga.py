@@ -65,7 +65,7 @@ from htetro_opt.operators.commands import (
 )
 from htetro_opt.operators.commands import as_column, sequences
 from htetro_opt.operators.commands.batch import apply_crossover, apply_mutation
-from htetro_opt.operators.commands.duplicates import chromosome_key, first_occurrences
+from htetro_opt.operators.commands.duplicates import chromosome_key, first_keys
 from htetro_opt.operators.commands.replan import CommandReplan
 from htetro_opt.operators.commands.shortcut import repair_shortcut_evaluate
 
@@ -88,11 +88,14 @@ _EVALUATED = ("F", "G", "H") + _COLUMNS  # what pymoo's evaluator marks evaluate
 
 
 class _Members:
-    """Individuals as arrays: chromosomes, ``F``, the auxiliary columns and, where one exists, the
-    pymoo ``Individual`` that stands for the row at the boundary."""
+    """Individuals as arrays: chromosomes, ``F``, the auxiliary columns and, where known, each
+    chromosome's :func:`~htetro_opt.operators.commands.duplicates.chromosome_key` and the pymoo
+    ``Individual`` that stands for the row at the boundary."""
 
-    def __init__(self, X: list, F: np.ndarray, columns: dict, individuals: list | None = None) -> None:
+    def __init__(self, X: list, F: np.ndarray, columns: dict, individuals: list | None = None,
+                 keys: list | None = None) -> None:
         self.X = X
+        self._keys = keys if keys is not None else [None] * len(X)
         self.F = F
         self.reached = np.asarray(columns["reached"]).astype(bool)
         self.executed = np.asarray(columns["executed"]).astype(np.int64)
@@ -112,17 +115,25 @@ class _Members:
     def take(self, rows: np.ndarray) -> "_Members":
         rows = np.asarray(rows, dtype=np.int64)
         return _Members([self.X[i] for i in rows], self.F[rows],
-                        {key: getattr(self, key)[rows] for key in _COLUMNS}, [self.individuals[i] for i in rows])
+                        {key: getattr(self, key)[rows] for key in _COLUMNS}, [self.individuals[i] for i in rows],
+                        [self._keys[i] for i in rows])
 
     def __add__(self, other: "_Members") -> "_Members":
         return _Members(self.X + other.X, np.concatenate([self.F, other.F]),
                         {key: np.concatenate([getattr(self, key), getattr(other, key)]) for key in _COLUMNS},
-                        self.individuals + other.individuals)
+                        self.individuals + other.individuals, self._keys + other._keys)
+
+    def keys(self) -> list[int]:
+        """Each chromosome's key, computed once."""
+        for i in [i for i, key in enumerate(self._keys) if key is None]:
+            self._keys[i] = chromosome_key(self.X[i])
+        return self._keys
 
     def trim_reached(self) -> None:
         """Cut every goal-reaching chromosome to its executed prefix, in place (see :func:`trim_reached`)."""
         for i in np.flatnonzero(self.reached & (np.fromiter(map(len, self.X), np.int64, len(self.X)) > self.executed)):
             self.X[i] = self.X[i][: self.executed[i]]
+            self._keys[i] = None
             if self.individuals[i] is not None:
                 self.individuals[i].set("X", as_column([self.X[i]])[0])
 
@@ -164,6 +175,11 @@ class HTetroGA(GeneticAlgorithm):
         :class:`~htetro_opt.operators.commands.CommandReplan`).
     replan_members : int
         How many random goal-reaching members are re-planned each generation besides the fastest one.
+    reach_share : float
+        Most share of the population the goal-reaching individuals keep while others can take the
+        rest (ours, off by default: 1 = the paper's sort, see
+        :class:`~htetro_opt.operators.GoalReachabilitySurvival`; measured in benchmarks/README.md,
+        0.75 changes little once the re-planning is on).
 
     Raises
     ------
@@ -206,6 +222,7 @@ class HTetroGA(GeneticAlgorithm):
         shortcut: bool = True,
         replan_window: int = 40,
         replan_members: int = 3,
+        reach_share: float = 1.0,
         **kwargs,
     ) -> None:
         pop_size = check_int(pop_size, "pop_size", minimum=2)
@@ -217,7 +234,7 @@ class HTetroGA(GeneticAlgorithm):
             selection=RankAndCrowdingTournament(tournament_size),
             crossover=crossover if crossover is not None else CommandCrossover(prob=1.0),
             mutation=mutation if mutation is not None else CommandMutation(),
-            survival=GoalReachabilitySurvival(niche_size=niche_size),
+            survival=GoalReachabilitySurvival(niche_size=niche_size, reach_share=reach_share),
             eliminate_duplicates=CommandDuplicateElimination(),
             advance_after_initial_infill=True,
             repair=CommandRepair() if repair else None,
@@ -257,7 +274,7 @@ class HTetroGA(GeneticAlgorithm):
         members = _Members.of(infills)
         if self.trim_reached:
             members.trim_reached()
-        members = members.take(first_occurrences(members.X))
+        members = members.take(first_keys(members.keys()))
         self._survive(members, len(members))
 
     def _infill(self):
@@ -300,15 +317,17 @@ class HTetroGA(GeneticAlgorithm):
             members = self._replan_members(rng)
             if len(members):
                 off = off + apply_mutation(self.replan, problem, [X[i] for i in members], random_state=rng)
-        keep = first_occurrences(off, {chromosome_key(x) for x in X})
+        keys = [chromosome_key(x) for x in off]
+        keep = first_keys(keys, set(parents.keys()))
         if not len(keep):
             return None  # nothing new this generation: it counts as one without improvement
         self.evaluator.n_eval += len(keep)
-        new = _Members(off[:n_varied], outcomes["F"], outcomes).take(keep[keep < n_varied])
-        replanned = [off[i] for i in keep[keep >= n_varied]]
-        if replanned:  # a few a generation (most re-planned members are unchanged, and dropped above)
-            outcomes = problem.outcomes(problem.simulate(replanned))
-            new = new + _Members(replanned, outcomes["F"], outcomes)
+        new = _Members(off[:n_varied], outcomes["F"], outcomes, keys=keys[:n_varied]).take(keep[keep < n_varied])
+        replanned = keep[keep >= n_varied]
+        if len(replanned):  # a few a generation (most re-planned members are unchanged, and dropped above)
+            X_replanned = [off[i] for i in replanned]
+            outcomes = problem.outcomes(problem.simulate(X_replanned))
+            new = new + _Members(X_replanned, outcomes["F"], outcomes, keys=[keys[i] for i in replanned])
         return new
 
     def _replan_members(self, rng: np.random.Generator) -> np.ndarray:
@@ -327,17 +346,18 @@ class HTetroGA(GeneticAlgorithm):
         if self.trim_reached:
             offspring.trim_reached()
         merged = self._members + offspring
-        merged = merged.take(first_occurrences(merged.X))
+        merged = merged.take(first_keys(merged.keys()))
         self._survive(merged, self.pop_size)
 
     def _survive(self, members: _Members, n_survive: int) -> None:
         rows, self._rank, self._crowding = self.survival.sort(members.F, members.end, n_survive,
                                                               random_state=self.random_state)
-        self._members = members.take(rows)
-        individuals = [self._members.individual(i, self.n_iter) for i in range(len(rows))]
-        for ind, rank, crowding in zip(individuals, self._rank, self._crowding):
+        self._members = members = members.take(rows)
+        for i in [i for i, ind in enumerate(members.individuals) if ind is None]:
+            members.individual(i, self.n_iter)  # new survivors only: the others keep theirs
+        for ind, rank, crowding in zip(members.individuals, self._rank, self._crowding):
             ind.data["rank"], ind.data["crowding"] = rank, crowding  # pymoo's Individual.set, less its lookups
-        self.pop = Population(individuals)
+        self.pop = Population(members.individuals)
 
     def _set_optimum(self):
         self.opt = self.pop[self._rank == 0]

@@ -6,18 +6,55 @@ import numpy as np
 from pymoo.core.termination import Termination
 
 from htetro_opt._validation import check_int, check_real
+from htetro_opt.errors import ParameterError
 from htetro_opt.operators.commands.survival import reaches_goal
 
-__all__ = ["FrontConvergence"]
+__all__ = ["FrontConvergence", "CONVERGENCE_MEASURES", "reaching_hypervolume"]
+
+CONVERGENCE_MEASURES = ("best", "hypervolume")
+"""What :class:`FrontConvergence` watches: the best of each fitness, or the best time and the
+hypervolume of the goal-reaching individuals."""
+
+_DEFAULT_TOLERANCE = {"best": 1e-9, "hypervolume": 1e-5}
+
+
+def reaching_hypervolume(F: np.ndarray) -> float:
+    """Hypervolume of the goal-reaching individuals' (f_t, f_sm, f_sf) in the fixed box [0, 1]³.
+
+    ``F`` holds pymoo's objectives ``(−f_gr, −f_t, −f_sm, −f_sf)``; the individuals with f_gr = 1 are
+    measured, each fitness clipped to [0, 1] (a path slower than t_max has f_t < 0 and adds nothing),
+    against the reference point (0, 0, 0). The box does not move with the front, so the value can be
+    compared between generations and runs; 0 when nobody reaches the goal.
+
+    Examples
+    --------
+    >>> F = -np.array([[1.0, 0.5, 1.0, 1.0], [1.0, 1.0, 0.5, 0.5], [0.5, 1.0, 1.0, 1.0]])
+    >>> reaching_hypervolume(F)  # 0.5 + 0.25 - their overlap 0.125
+    0.625
+    """
+    from moocore import hypervolume
+
+    F = np.asarray(F, dtype=float)
+    reached = reaches_goal(F)
+    if not reached.any():
+        return 0.0
+    return float(hypervolume(-np.clip(-F[reached, 1:], 0.0, 1.0), ref=np.zeros(3)))
 
 
 class FrontConvergence(Termination):
-    """Stop after ``max_gen`` generations, or once the leading front has stopped improving.
+    """Stop after ``max_gen`` generations, or once the goal-reaching front has stopped improving.
 
     The front counts as converged when some individual reaches the goal and for ``patience``
-    generations in a row neither the best f_t, f_sm or f_sf among the goal-reaching individuals
-    nor their best sum of the four fitnesses (the paper's multi-objective solution) has improved.
-    (The front's membership itself keeps changing as crowding distance trades equivalent points.)
+    generations in a row it has not improved, by one of two measures (``measure``):
+
+    - ``"best"``: neither the best f_t, f_sm or f_sf among the goal-reaching individuals nor their
+      best sum of the four fitnesses (the paper's multi-objective solution) has risen by more than
+      ``tolerance``. Any member's gain on one of the four restarts the count, however small.
+    - ``"hypervolume"``: neither the best f_t has risen nor the front's hypervolume in the fixed box
+      [0, 1]³ of (f_t, f_sm, f_sf) (:func:`reaching_hypervolume`) by more than ``tolerance``. A
+      faster path always counts; a better trade-off counts when it enlarges the front by more than
+      ``tolerance`` of the box. The front's membership itself keeps changing as crowding distance
+      trades equivalent points, which neither measure sees.
 
     Parameters
     ----------
@@ -25,8 +62,11 @@ class FrontConvergence(Termination):
         n_pop,max of the paper (1000).
     patience : int
         Generations without improvement that count as convergence.
-    tolerance : float
-        Smallest increase that counts as an improvement.
+    tolerance : float, optional
+        Smallest increase that counts as an improvement (of a fitness, or of the hypervolume);
+        default 1e-9 with ``"best"``, 1e-5 with ``"hypervolume"``.
+    measure : {"best", "hypervolume"}, keyword-only
+        See above; ``"best"`` by default.
 
     Attributes
     ----------
@@ -38,7 +78,8 @@ class FrontConvergence(Termination):
     Raises
     ------
     ParameterError
-        If ``max_gen`` or ``patience`` is not a positive integer, or ``tolerance`` is negative.
+        If ``max_gen`` or ``patience`` is not a positive integer, ``tolerance`` is negative, or
+        ``measure`` is not one of :data:`CONVERGENCE_MEASURES`.
 
     Examples
     --------
@@ -53,24 +94,35 @@ class FrontConvergence(Termination):
     (True, True)
     """
 
-    def __init__(self, max_gen: int = 1000, patience: int = 100, tolerance: float = 1e-9) -> None:
+    def __init__(self, max_gen: int = 1000, patience: int = 100, tolerance: float | None = None, *,
+                 measure: str = "best") -> None:
         super().__init__()
+        if not isinstance(measure, str) or measure not in CONVERGENCE_MEASURES:
+            raise ParameterError(f"measure must be one of {', '.join(CONVERGENCE_MEASURES)}, got {measure!r}")
+        self.measure = measure
         self.max_gen = check_int(max_gen, "max_gen", minimum=1)
         self.patience = check_int(patience, "patience", minimum=1)
-        self.tolerance = check_real(tolerance, "tolerance", minimum=0.0)
+        self.tolerance = check_real(_DEFAULT_TOLERANCE[measure] if tolerance is None else tolerance, "tolerance",
+                                    minimum=0.0)
         self.stall = 0
         self.best: np.ndarray | None = None
         self.converged = False
+
+    def _watched(self, F: np.ndarray, reached: np.ndarray) -> np.ndarray:
+        """The values whose rise counts as an improvement."""
+        fitness = -F[reached]
+        if self.measure == "best":
+            return np.append(fitness[:, 1:].max(axis=0), fitness.sum(axis=1).max())
+        return np.array([fitness[:, 1].max(), reaching_hypervolume(F)])
 
     def _update(self, algorithm) -> float:
         F = algorithm.pop.get("F")
         progress = algorithm.n_gen / self.max_gen
         reached = reaches_goal(F)
         if reached.any():
-            fitness = -F[reached]
-            best = np.append(fitness[:, 1:].max(axis=0), fitness.sum(axis=1).max())
-            improved = self.best is None or (best > self.best + self.tolerance).any()
-            self.best = best if self.best is None else np.maximum(best, self.best)
+            watched = self._watched(F, reached)
+            improved = self.best is None or (watched > self.best + self.tolerance).any()
+            self.best = watched if self.best is None else np.maximum(watched, self.best)
             self.stall = 0 if improved else self.stall + 1
             self.converged = self.stall >= self.patience
             progress = max(progress, self.stall / self.patience)

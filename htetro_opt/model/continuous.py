@@ -45,6 +45,7 @@ __all__ = [
     "Corners",
     "as_polygon",
     "as_robot_radius",
+    "closest_approach",
     "enclosing_radius",
     "path_length",
     "path_smoothness",
@@ -230,6 +231,34 @@ def robot_distance(path_a, path_b) -> float:
     u = np.clip(-(p * d).sum(axis=1) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
     closest = p + u[:, None] * d
     return float(np.hypot(closest[:, 0], closest[:, 1]).min())
+
+
+def closest_approach(path_a, path_b) -> tuple[float, float]:
+    """Where two robots come closest, as :func:`robot_distance` defines their motion: the distance
+    and the time (= the arc length each has travelled, at unit speed) when it first occurs.
+
+    Examples
+    --------
+    >>> closest_approach([[0, 0], [4, 0]], [[4, 1], [0, 1]])
+    (1.0, 2.0)
+    """
+    a, b = _as_points(path_a, "path_a"), _as_points(path_b, "path_b")
+    if not len(a) or not len(b):
+        raise ParameterError("closest_approach needs two non-empty paths")
+    (a, sa), (b, sb) = _arclength(a), _arclength(b)
+    times = np.union1d(sa, sb)
+    rel = np.column_stack([np.interp(times, sa, a[:, 0]) if len(a) > 1 else np.full(len(times), a[0, 0]),
+                           np.interp(times, sa, a[:, 1]) if len(a) > 1 else np.full(len(times), a[0, 1])])
+    rel -= np.column_stack([np.interp(times, sb, b[:, 0]) if len(b) > 1 else np.full(len(times), b[0, 0]),
+                            np.interp(times, sb, b[:, 1]) if len(b) > 1 else np.full(len(times), b[0, 1])])
+    if len(rel) == 1:
+        return float(np.hypot(*rel[0])), 0.0
+    p, d = rel[:-1], np.diff(rel, axis=0)
+    dd = (d * d).sum(axis=1)
+    u = np.clip(-(p * d).sum(axis=1) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
+    gaps = np.hypot(*(p + u[:, None] * d).T)
+    k = int(np.argmin(gaps))
+    return float(gaps[k]), float(times[k] + u[k] * (times[k + 1] - times[k]))
 
 
 def _arclength(path: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -7,7 +7,10 @@
   every planner on them;
 - :mod:`~htetro_opt.problems.waypoint_sequencing` (Le et al. 2018): tile waypoints (Algorithm 1), the
   eq.-2 block-displacement cost and the open-path TSP over them, for every sequencing method, plus
-  :class:`SequencingProblem`, the same as a pymoo permutation problem.
+  :class:`SequencingProblem`, the same as a pymoo permutation problem;
+- :mod:`~htetro_opt.problems.path_bases` (Nazarahari et al. 2019): a continuous path as its path
+  bases (one object variable, K robots jointly), eqs. 4–6 and the multi-robot penalty, as a pymoo
+  problem.
 
 Names load lazily, so that importing the sequencing problem does not import pymoo.
 """
@@ -21,6 +24,9 @@ __getattr__, __dir__, __all__ = attach(__name__, {
        ("DEFAULT_BLOCK_WEIGHTS", "SequencingInstance", "block_locations", "check_weights", "cost_matrix",
         "path_cost", "check_instance")},
     "SequencingProblem": "._sequencing_problem",
+    **{name: ".path_bases" for name in
+       ("PathBasesProblem", "PATH_KINDS", "SAFETY_KINDS", "OBJECTIVE_KINDS", "DEFAULT_PATH_WEIGHTS",
+        "check_path_weights", "spline_path", "render_path")},
     **{name: ".heat_costs" for name in
        ("HEAT_COST_NAMES", "SAFETY_RADIUS", "check_heat_weights", "default_t_max", "safety_pattern",
         "heat_fitness")},

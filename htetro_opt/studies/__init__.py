@@ -7,6 +7,9 @@
 - :mod:`htetro_opt.studies.do2021`: Do et al. 2021's Tables 6–8 and Fig. 13 (the heat-conduction
   planner under four weightings, beside the hTetro-GA, the exact optimum and O-shape-only A* and
   Dijkstra; replanning with hidden obstacles), every plan scored by the paper's costs;
+- :mod:`htetro_opt.studies.cheng2019`: Cheng et al. 2019's Table 2 (complete coverage over seven
+  morphology sets and two stripe widths, by our reading and by the paper's Alg. 5), its 16 × 7 map,
+  two baselines and two larger maps, every plan beside its lower bound;
 - :mod:`htetro_opt.studies.metrics`: mean ± standard deviation aggregation over trial records.
 
 Studies may use the model, problems, solvers and scenarios, never the plotting or the command line.

@@ -1,7 +1,7 @@
 """Studies at scale: scenarios × methods × seeds, on one machine or a Dask cluster, resumable.
 
-A **study** (:class:`Study`) names a task (the command-line verb it stands for: ``plan``, ``tile``
-or ``sequence``), the scenarios to run it on, the methods with their options, the seeds, and the
+A **study** (:class:`Study`) names a task (the command-line verb it stands for: ``plan``, ``tile``,
+``sequence`` or ``cover``), the scenarios to run it on, the methods with their options, the seeds, and the
 optional metrics to record. It is built in Python or read from a TOML file (:func:`load_study`: a
 bundled name, ``htetro-opt``'s ``studies/data/*.toml``, or a path), which reads like the command
 line it stands for: ``task`` is the verb, each method's keys are that verb's options with
@@ -37,7 +37,14 @@ on the first four maps of its Table 6). The options:
   ``shuffle`` (then the trials are seeded), ``time_limit`` (default: none);
 - ``sequence``: any sequencing method (``auto``, ``exact``, ``ortools``, ``local``, ``ga``, …);
   ``start`` (a tile label or ``"free"``), ``weights`` (``[a, b, c, d]`` or ``"a,b,c,d"``),
-  ``time_limit``, ``shapes`` (for scenarios, which are tiled first).
+  ``time_limit``, ``shapes`` (for scenarios, which are tiled first);
+- ``cover`` (complete coverage, Cheng et al. 2019): method ``stripes``, ``stripes-paper``,
+  ``boustrophedon`` or ``tiling-tsp``; ``shapes`` (the morphology layers, ``"O,vI,hI"`` or a list
+  such as ``["O", "hI"]``; default the paper's O, vI, hI), ``start`` (``"scenario"``: the roadmap's
+  first and last poses, as on the command line, or ``"auto"``), ``clearance``; ``stripes`` (a width
+  or widths bottom up, ``[2, 3, 2]`` or ``"2,3,2"``, checked against every scenario's height),
+  ``region_columns``, ``budget`` (the stripes methods); ``time_limit`` (the stripes methods and
+  ``tiling-tsp``). Every coverage method is deterministic: its trials run once.
 
 Seeds come from the study, never from a method entry. The whole study is checked before any trial
 runs (:class:`StudyError` names the file, the method entry ``methods[i]``, counted from 0, and the
@@ -50,7 +57,11 @@ whose result does not depend on a seed (the exact planners, the heat planner, a 
 ``shuffle``, the deterministic sequencing methods) runs once per scenario, its record's ``seed`` None.
 The gap to the exact optimum (metric ``"gap"``) comes from one **reference** trial per scenario and
 run (:func:`run_reference`: Dijkstra for ``plan``, the CP-SAT optimum for ``sequence``), recorded in
-the results file like the others. A ``plan`` reference takes the trial's ``clearance`` and command
+the results file like the others. A ``cover`` trial has no optimum to compare with: its record
+always holds the lower bound ⌈(coverable − 4) / g⌉ on its action cost (g: the most new cells one
+command adds, 2 for {O}, 4 with an I; every plan starts on 4 covered cells), computed from the
+trial's own coverable cells, and metric ``"gap"`` sets ``reference`` to that bound and ``gap`` to
+the cost over it (no reference trial). A ``plan`` reference takes the trial's ``clearance`` and command
 set: the exact methods' ``diagonals``, none for the GAs (their chromosomes have no diagonals), and
 always the diagonals for the heat planner, whose 17 commands (Do et al. 2021) include them.
 
@@ -143,6 +154,7 @@ __all__ = [
     "StudyRun",
     "Trial",
     "WorkerLost",
+    "coverage_bound",
     "front_metrics",
     "hypervolume",
     "list_studies",
@@ -157,7 +169,7 @@ __all__ = [
     "write_summary",
 ]
 
-TASKS = ("plan", "tile", "sequence")
+TASKS = ("plan", "tile", "sequence", "cover")
 """The tasks a study can run: the command-line verbs of the same names."""
 
 EXECUTORS = ("serial", "processes", "dask")
@@ -167,10 +179,15 @@ METRICS = {
     "plan": ("objectives", "generations", "fitness", "gap", "heat_fitness", "front", "history", "hv_curve"),
     "tile": (),
     "sequence": ("gap",),
+    "cover": ("gap",),
 }
 """Optional metrics per task, beyond those every record holds (plan: ``reached``, ``time``,
 ``n_commands``; tile: ``tiles``, ``overlapping``, ``n_I`` … ``n_T``; sequence: ``cost``,
-``waypoints``):
+``waypoints``; cover: ``action_cost``, ``time``, ``complete``, ``free``, ``coverable``,
+``covered``, ``uncoverable``, ``lower_bound``, ``average_coverage_time``, ``recovered_pct``,
+``coverage_pct``, ``coverable_pct``, ``path_length``, ``switches``, ``turns``, ``regions``,
+``regions_optimal``, ``memo_hits``, ``nodes``, ``mopup_commands``, ``transit_commands``,
+``dag_cost``, ``time_limited`` and ``layers``, the morphology set the plan used):
 
 - ``objectives``: ``translations``, ``rotations``, ``shapeshifts``, ``path_length`` (:meth:`Plan.objectives`);
 - ``generations``: the GAs' ``generations`` (summed over the legs), ``reach_generation`` and
@@ -178,7 +195,9 @@ METRICS = {
 - ``fitness``: the GAs' ``f_gr``, ``f_t``, ``f_sm``, ``f_sf`` of the multi-objective solution,
   averaged over the legs (Cheng et al. 2020's Table 4);
 - ``gap``: ``reference`` (the exact optimum's time or cost) and ``gap`` = (value − reference) /
-  reference; for ``sequence`` only where the optimum is proven (≤ 40 waypoints);
+  reference; for ``sequence`` only where the optimum is proven (≤ 40 waypoints); for ``cover``
+  the reference is the trial's ``lower_bound`` (a bound, not an optimum: its gap is an upper bound
+  on the gap to the optimum);
 - ``heat_fitness`` (every plan method): Do et al. 2021's costs of the plan
   (:func:`~htetro_opt.problems.heat_costs.heat_fitness`, eqs. 9–12 with Fig. 5's safety), so that
   a GA's, an exact and a heat plan are scored alike: ``heat_f_t``, ``heat_f_sm``, ``heat_f_sf``,
@@ -209,9 +228,15 @@ _METRIC_FIELDS = {
              "heat_f_t", "heat_f_sm", "heat_f_sf", "heat_f", "shapes_used", "hv", "igd_plus"),
     "tile": ("tiles", "overlapping", "n_I", "n_O", "n_L", "n_J", "n_Z", "n_S", "n_T"),
     "sequence": ("cost", "waypoints", "optimal", "reference", "gap"),
+    # the summary's columns; the records hold more (path_length, turns, memo_hits, nodes, …)
+    "cover": ("action_cost", "time", "coverable", "covered", "lower_bound", "reference", "gap",
+              "average_coverage_time", "recovered_pct", "coverage_pct", "switches", "regions", "regions_optimal",
+              "mopup_commands"),
 }
 _PLAN_ALIASES = {"exact": "dijkstra"}  # the issue's study files call the minimum-time plan "exact"
 _HEAT_METHODS = ("heat",)  # Do et al. 2021's planner: weights and field options, no seed
+_STRIPE_METHODS = ("stripes", "stripes-paper")  # Cheng et al. 2019's planners: stripes, regions, budgets
+_TILING_GAIN = 4  # tiling-tsp's legs pass through any state: no command adds more than 4 new cells
 _EQUAL_WEIGHTS = (1.0, 1.0, 1.0)  # heat_f of the plans that optimise no (w_t, w_sm, w_sf)
 _TOP_KEYS = ("name", "description", "task", "scenarios", "seeds", "metrics", "methods")
 _ENTRY_KEYS = ("method", "label", "scenarios", "per_scenario")
@@ -242,9 +267,23 @@ def _plan_kind(method: str) -> str:
     return "heat" if method in _HEAT_METHODS else "ga"
 
 
+def _kind(task: str, method: str) -> str:
+    """Which option set a method takes: plan's :func:`_plan_kind`; cover: ``"stripes"`` (both stripe
+    planners) or the method's name; the other tasks: the method's name."""
+    if task == "plan":
+        return _plan_kind(method)
+    if task == "cover" and method in _STRIPE_METHODS:
+        return "stripes"
+    return method
+
+
 def _methods_of(task: str) -> tuple[str, ...]:
     if task == "plan":
         return _plan_methods()[0]
+    if task == "cover":
+        from htetro_opt.solvers.coverage import COVERAGE_METHODS
+
+        return tuple(COVERAGE_METHODS)
     if task == "tile":
         from htetro_opt.solvers.tiling import TILING_METHODS
 
@@ -308,6 +347,46 @@ def _check_band(value, name: str) -> str | int:
                              f"got {value!r}") from None
 
 
+def _check_layers(value, name: str) -> str:
+    """A coverage morphology set: ``"O,vI"`` or ``["O", "vI"]`` (any form of
+    :func:`~htetro_opt.solvers.coverage.parse_layers`), as its layers' names joined by commas."""
+    from htetro_opt.errors import UnknownShapeError
+    from htetro_opt.solvers.coverage import parse_layers
+
+    if not isinstance(value, (str, list, tuple)):
+        raise ParameterError(f"{name} must be morphology layers such as 'O,vI,hI' or ['O', 'hI'], got {value!r}")
+    try:
+        return ",".join(layer.name for layer in parse_layers(value))
+    except UnknownShapeError as err:
+        raise ParameterError(f"{name}: {err.args[0]}") from None
+
+
+def _check_stripes(value, name: str) -> int | list[int]:
+    """Stripe widths: a width (an int, or ``"4"``) or widths bottom up (``[2, 3, 2]`` or ``"2,3,2"``),
+    each a positive integer; whether they fit a map is checked against each scenario's height."""
+    if isinstance(value, str):  # the command line's "--stripes 2,3,2"
+        parts = [p.strip() for p in value.split(",")]
+        if not all(p.isdigit() for p in parts):
+            raise ParameterError(f"{name} must be a width or comma-separated widths such as '2,3,2', got {value!r}")
+        value = int(parts[0]) if len(parts) == 1 else [int(p) for p in parts]
+    if isinstance(value, (list, tuple)):
+        if not value:
+            raise ParameterError(f"{name} must name at least one width, got {value!r}")
+        return [check_int(v, f"{name}[{i}]", minimum=1) for i, v in enumerate(value)]
+    try:
+        return check_int(value, name, minimum=1)
+    except ParameterError:
+        raise ParameterError(f"{name} must be a width (an integer ≥ 1) or a list of widths bottom up, "
+                             f"got {value!r}") from None
+
+
+def _check_cover_start(value, name: str) -> str:
+    if value not in ("scenario", "auto"):
+        raise ParameterError(f"{name} must be 'scenario' (the roadmap's first and last poses) or 'auto' (the "
+                             f"bottom-left pose of the first layer, a free end), got {value!r}")
+    return value
+
+
 def _check_weights(value, name: str) -> list[float]:
     from htetro_opt.problems import check_weights
 
@@ -354,16 +433,26 @@ _OPTIONS: dict[str, dict[str, tuple[Callable, str | None]]] = {
         "time_limit": (check_time_limit, _ALL),
         "shapes": (_check_shapes, _ALL),
     },
+    "cover": {
+        "shapes": (_check_layers, _ALL),
+        "start": (_check_cover_start, _ALL),
+        "clearance": (_check_clearance, _ALL),
+        "stripes": (_check_stripes, "stripes"),
+        "region_columns": (lambda v, n: check_int(v, n, minimum=1), "stripes"),
+        "budget": (lambda v, n: check_int(v, n, minimum=1), "stripes"),
+        "time_limit": (check_time_limit, ("stripes", "tiling-tsp")),
+    },
 }
 _REFERENCE_OPTIONS = {"plan": ("clearance", "diagonals"), "sequence": ("start", "weights", "shapes")}
 
 
 _SCOPE_NAMES = {"exact": "the exact methods (dijkstra, astar)", "heat": "the heat planner (Do et al. 2021)",
-                "ga": "the GA methods"}
+                "ga": "the GA methods", "stripes": "the stripes methods (stripes, stripes-paper)",
+                ("stripes", "tiling-tsp"): "the stripes methods (stripes, stripes-paper) and tiling-tsp"}
 
 
-def _takes(task: str, method: str, scope: str | None) -> bool:
-    return scope is None or _plan_kind(method) == scope
+def _takes(task: str, method: str, scope: str | tuple[str, ...] | None) -> bool:
+    return scope is None or _kind(task, method) in ((scope,) if isinstance(scope, str) else scope)
 
 
 def _seeded(task: str, method: str, parameters: Mapping[str, Any]) -> bool:
@@ -372,6 +461,8 @@ def _seeded(task: str, method: str, parameters: Mapping[str, Any]) -> bool:
         return _plan_kind(method) == "ga"
     if task == "tile":
         return bool(parameters.get("shuffle", False))
+    if task == "cover":
+        return False
     from htetro_opt.studies.le2018 import (
         STOCHASTIC,  # the sequencing methods that draw random numbers
     )
@@ -506,7 +597,7 @@ class Study:
     ----------
     name : str
         Names the results files (``<name>.jsonl``, ``.csv``, ``.md``): letters, digits, ``_.-``.
-    task : {"plan", "tile", "sequence"}
+    task : {"plan", "tile", "sequence", "cover"}
     scenarios : sequence of str
         Bundled names or files (``sequence``: labelled tilesets too, or scenarios to tile first).
     methods : sequence of mapping or MethodSpec
@@ -588,8 +679,9 @@ class Study:
         return out
 
     def references(self) -> dict[str, Trial]:
-        """The reference trial (the exact optimum) of each trial that asks for a gap, by trial key."""
-        if "gap" not in self.metrics:
+        """The reference trial (the exact optimum) of each trial that asks for a gap, by trial key (none
+        for ``cover``, whose trials measure their gap to their own lower bound)."""
+        if "gap" not in self.metrics or self.task not in _REFERENCE_OPTIONS:
             return {}
         return {trial.key: reference_trial(trial) for trial in self.trials()}
 
@@ -683,6 +775,8 @@ def _check_options(task, method, options, scenarios, where) -> dict:
         if not _takes(task, method, scope):
             implied = " (it always plans with the diagonals)" if key == "diagonals" and method in _HEAT_METHODS else ""
             raise StudyError(f"{where}: {key} applies to {_SCOPE_NAMES[scope]} only, not to {method}{implied}")
+        if task == "cover" and key == "stripes":
+            _check_stripes_fit(value, scenarios, where)
         if task == "sequence" and key == "shapes":
             tilesets = [s for s in scenarios if _is_tileset(s)]
             if tilesets:
@@ -693,6 +787,23 @@ def _check_options(task, method, options, scenarios, where) -> dict:
         except ParameterError as err:
             raise StudyError(f"{where}: {err}") from err
     return out
+
+
+def _check_stripes_fit(value, scenarios, where) -> None:
+    """Stripe widths that fit every one of ``scenarios``: a width at most its height, widths summing to it."""
+    from htetro_opt.solvers.coverage import stripe_widths
+
+    try:
+        value = _check_stripes(value, "stripes")
+    except ParameterError as err:
+        raise StudyError(f"{where}: {err}") from err
+    for scenario in scenarios:
+        grid = _grid_scenario(scenario)
+        try:
+            stripe_widths(value, grid.workspace.height)
+        except ParameterError as err:
+            raise StudyError(f"{where}: {err} (scenario {grid.name!r}, {grid.workspace.height} rows; give its "
+                             "widths under per_scenario)") from err
 
 
 def _check_methods(task, methods, scenarios, written, where) -> tuple[MethodSpec, ...]:
@@ -975,6 +1086,52 @@ def _sequence(scenario, method, parameters, seed) -> tuple[dict, dict, float]:
     return out, {"order": ",".join(str(t) for t in result.tiles)}, result.runtime_s
 
 
+def coverage_bound(coverable: int, gain: int) -> int:
+    """The lower bound on a coverage plan's action cost: ⌈(coverable − 4) / gain⌉, at least 0.
+
+    The robot starts on 4 covered cells and no command adds more than ``gain`` new ones.
+
+    Examples
+    --------
+    >>> coverage_bound(216, 2), coverage_bound(216, 4), coverage_bound(3, 4)
+    (106, 53, 0)
+    """
+    return max(0, math.ceil((int(coverable) - 4) / int(gain)))
+
+
+def _cover(scenario, method, parameters, metrics) -> tuple[dict, dict, float]:
+    from htetro_opt.solvers.coverage import DEFAULT_LAYERS, LayerGraph, plan_coverage
+
+    grid = _grid_scenario(scenario)
+    options = {k: v for k, v in parameters.items() if k not in ("shapes", "start")}
+    start = goal = None
+    if parameters.get("start", "scenario") == "scenario" and grid.roadmap:  # as the command line's --start
+        start, goal = grid.start, grid.goal
+    plan = plan_coverage(grid.workspace, parameters.get("shapes", ",".join(DEFAULT_LAYERS)), method=method,
+                         start=start, goal=goal, **options)
+    coverable = int(plan.coverable.sum())
+    # g of the layers the plan used (boustrophedon: the first); tiling-tsp's legs leave the layers
+    gain = _TILING_GAIN if method == "tiling-tsp" else \
+        LayerGraph(grid.workspace, plan.layers, clearance=parameters.get("clearance", 0.0)).gain
+    bound = coverage_bound(coverable, gain)
+    cost = plan.action_cost
+    out = {"action_cost": cost, "time": plan.time, "complete": plan.complete, "free": int(plan.free.sum()),
+           "coverable": coverable, "covered": int((plan.covered & plan.free).sum()),
+           "uncoverable": len(plan.uncoverable), "lower_bound": bound}
+    if "gap" in metrics:
+        out["reference"] = bound
+        out["gap"] = (cost - bound) / bound if bound > 0 else (0.0 if cost == 0 else None)
+    out.update({"average_coverage_time": plan.average_coverage_time, "recovered_pct": plan.recovered_pct,
+                "coverage_pct": plan.coverage_pct, "coverable_pct": plan.coverable_pct,
+                "path_length": plan.path_length, "switches": plan.switches, "turns": plan.turns,
+                "regions": plan.regions, "regions_optimal": plan.regions_optimal, "memo_hits": plan.memo_hits,
+                "nodes": plan.nodes, "mopup_commands": plan.mopup_commands, "transit_commands": plan.transit_commands,
+                "dag_cost": plan.dag_cost, "time_limited": plan.time_limited, "layers": ",".join(plan.layers)})
+    s = plan.start
+    solution = {"commands": ",".join(plan.tokens), "start_pose": [int(s.x), int(s.y), s.shape, int(s.heading)]}
+    return out, solution, plan.runtime_s
+
+
 def _record(head: dict, metrics: Mapping[str, Any], solution: Mapping[str, Any], runtime_s: float | None,
             error: str | None = None) -> dict:
     record = dict(head)
@@ -1001,7 +1158,7 @@ def run_trial(task: str, scenario: str, method: str, parameters: Mapping[str, An
 
     Parameters
     ----------
-    task : {"plan", "tile", "sequence"}
+    task : {"plan", "tile", "sequence", "cover"}
     scenario : str
         A bundled name or a file (``sequence``: a labelled tileset, or a scenario tiled first).
     method : str
@@ -1010,7 +1167,8 @@ def run_trial(task: str, scenario: str, method: str, parameters: Mapping[str, An
         The verb's options, as a study's method entry gives them (``plan``: clearance, diagonals,
         pop_size, max_gen, patience, max_length, and the heat planner's weights, t_max, element,
         monotone, band; ``tile``: shapes, overlap, shuffle, time_limit; ``sequence``: start,
-        weights, time_limit, shapes).
+        weights, time_limit, shapes; ``cover``: shapes, start, clearance, stripes, region_columns,
+        budget, time_limit).
     seed : int or None
         The seed of a seeded method (None for the others, which run with their default).
     label : str, keyword-only
@@ -1024,7 +1182,8 @@ def run_trial(task: str, scenario: str, method: str, parameters: Mapping[str, An
     dict
         ``key`` (sha256 of the inputs), ``kind``, ``task``, ``scenario``, ``method``, ``label``,
         ``seed``, the parameters, the metrics, the solution (plan: ``commands``; tile: ``tileset``,
-        the labelled rows top-down joined by ``;``; sequence: ``order``, tile labels), ``runtime_s``
+        the labelled rows top-down joined by ``;``; sequence: ``order``, tile labels; cover:
+        ``commands`` from ``start_pose``, ``[x, y, shape, heading]``), ``runtime_s``
         (the solver's), ``error`` (None) and ``version``.
 
     Raises
@@ -1055,6 +1214,8 @@ def run_trial(task: str, scenario: str, method: str, parameters: Mapping[str, An
         values, solution, runtime = _plan(scenario, method, parameters, seed, metrics)
     elif task == "tile":
         values, solution, runtime = _tile(scenario, method, parameters, seed)
+    elif task == "cover":
+        values, solution, runtime = _cover(scenario, method, parameters, metrics)
     else:
         values, solution, runtime = _sequence(scenario, method, parameters, seed)
     return _record(head, values, solution, runtime)
@@ -1076,7 +1237,8 @@ def run_reference(task: str, scenario: str, parameters: Mapping[str, Any]) -> di
     """
     _check_trial_inputs(task, scenario, parameters)
     if task not in _REFERENCE_OPTIONS:
-        raise ParameterError(f"task {task!r} has no exact reference (plan and sequence have)")
+        raise ParameterError(f"task {task!r} has no exact reference (plan and sequence have; a cover trial "
+                             "records its own lower bound)")
     trial = reference_trial(Trial(task, scenario, "dijkstra" if task == "plan" else "exact", parameters, None,
                                   "reference"))
     if task == "plan":

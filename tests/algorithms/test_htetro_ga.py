@@ -104,7 +104,8 @@ def test_trim_reached_function():
 
 @pytest.mark.parametrize("options", [dict(pop_size=1), dict(pop_size=2.5), dict(pop_size=True),
                                      dict(crossover_rate=1.5), dict(crossover_rate=-0.1), dict(niche_size=-1),
-                                     dict(repair=1), dict(shortcut="no"), dict(trim_reached=None)])
+                                     dict(repair=1), dict(shortcut="no"), dict(trim_reached=None),
+                                     dict(reach_share=0), dict(reach_share=1.2)])
 def test_htetro_ga_parameters(options):
     with pytest.raises(ParameterError):
         HTetroGA(**options)
@@ -219,3 +220,12 @@ def test_replanning_keeps_the_run_reproducible_and_leaves_the_paper_variant_alon
     off = minimize(problem, HTetroGA(16, repair=False, shortcut=False, niche_size=0, replan_window=0), ("n_gen", 8),
                    seed=2)
     assert population_arrays(paper)[1] == population_arrays(off)[1]
+
+
+def test_a_reaching_share_keeps_explorers(problem):
+    # the goal is reached early on this open map: the paper's sort soon holds reaching members only
+    counts = {}
+    for share in (1.0, 0.5):
+        res = minimize(problem, HTetroGA(pop_size=20, reach_share=share), ("n_gen", 15), seed=0)
+        counts[share] = int(res.pop.get("reached").astype(bool).sum())
+    assert counts[1.0] == 20 and counts[0.5] == 10

@@ -78,3 +78,68 @@ def test_a_run_reports_convergence_on_its_result(small_problem):
 def test_a_capped_run_reports_no_convergence(small_problem):
     res = minimize(small_problem, HTetroGA(pop_size=12), FrontConvergence(max_gen=2, patience=50), seed=0)
     assert res.data["converged"] is False
+
+
+# --- the hypervolume measure ------------------------------------------------------------------
+def dominated_cells(points, k=4):
+    """Oracle: the volume of the union of boxes [0, p] in [0, 1]³, by counting the cells of a k-grid
+    (exact for coordinates that are multiples of 1 / k)."""
+    centres = (np.arange(k) + 0.5) / k
+    grid = np.stack(np.meshgrid(centres, centres, centres, indexing="ij"), axis=-1).reshape(-1, 3)
+    covered = np.zeros(len(grid), dtype=bool)
+    for p in points:
+        covered |= (grid <= p).all(axis=1)
+    return covered.sum() / k**3
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_reaching_hypervolume_is_the_dominated_volume_of_the_reaching_members(seed):
+    from htetro_opt.algorithms import reaching_hypervolume
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 9))
+    fitness = rng.integers(-1, 6, size=(n, 3)) / 4  # quarters, some below 0 and above 1 (clipped)
+    reached = rng.random(n) < 0.7
+    F = -np.column_stack([np.where(reached, 1.0, 0.5), fitness])
+    expected = dominated_cells(np.clip(fitness[reached], 0, 1)) if reached.any() else 0.0
+    assert reaching_hypervolume(F) == pytest.approx(expected, abs=1e-12)
+
+
+def test_hypervolume_convergence_counts_a_faster_path_or_a_larger_front():
+    term = FrontConvergence(max_gen=100, patience=2, measure="hypervolume")
+    assert term.tolerance == 1e-5 and FrontConvergence().tolerance == 1e-9
+    front = -np.array([[1.0, 0.5, 0.5, 0.5]])
+    term.update(fake_algorithm(front, 1))
+    term.update(fake_algorithm(front, 2))
+    assert term.stall == 1
+    best_sum_up = -np.array([[1.0, 0.5, 0.5, 0.5], [1.0, 0.4, 0.7, 0.7]])  # a new trade-off: the volume grows
+    term.update(fake_algorithm(best_sum_up, 3))
+    assert term.stall == 0
+    inside = -np.array([[1.0, 0.5, 0.5, 0.5], [1.0, 0.4, 0.7, 0.7], [1.0, 0.45, 0.5, 0.5]])  # dominated: no gain
+    term.update(fake_algorithm(inside, 4))
+    assert term.stall == 1
+    faster = -np.array([[1.0, 0.52, 0.1, 0.1]])  # a smaller front, but a faster path
+    term.update(fake_algorithm(faster, 5))
+    assert term.stall == 0
+    term.update(fake_algorithm(faster, 6))
+    term.update(fake_algorithm(faster, 7))
+    assert term.converged and term.has_terminated()
+
+
+def test_the_best_measure_counts_what_the_hypervolume_one_ignores():
+    # a member's safety rising inside the front restarts "best" but not "hypervolume"
+    before = -np.array([[1.0, 0.6, 0.9, 0.3], [1.0, 0.5, 0.5, 0.9]])
+    after = -np.array([[1.0, 0.6, 0.9, 0.3], [1.0, 0.5, 0.5, 0.9], [1.0, 0.1, 0.1, 0.95]])  # adds 0.0005
+    stalls = {}
+    for measure in ("best", "hypervolume"):
+        term = FrontConvergence(patience=10, measure=measure, tolerance=1e-3)
+        term.update(fake_algorithm(before, 1))
+        term.update(fake_algorithm(after, 2))
+        stalls[measure] = term.stall
+    assert stalls == {"best": 0, "hypervolume": 1}
+
+
+@pytest.mark.parametrize("measure", ["volume", None, 1])
+def test_an_unknown_measure_is_refused(measure):
+    with pytest.raises(ParameterError, match="measure"):
+        FrontConvergence(measure=measure)

@@ -568,3 +568,29 @@ def test_survival_validates_niche_size():
 def test_reaches_goal():
     F = -np.array([[1.0, 0.1, 0.1, 0.1], [0.999, 1, 1, 1], [0.5, 0, 0, 0]])
     assert reaches_goal(F).tolist() == [True, False, False]
+
+
+@settings(max_examples=60, deadline=None)
+@given(data=st.data(), n=st.integers(1, 30), seed=seeds, share=st.sampled_from([0.25, 0.5, 0.75, 1.0]))
+def test_the_reaching_share_leaves_room_for_the_others(data, n, seed, share):
+    f_gr = np.array(data.draw(st.lists(st.sampled_from(LEVELS), min_size=n, max_size=n)))
+    n_survive = data.draw(st.integers(1, n + 3))
+    rng = np.random.default_rng(seed)
+    F = np.column_stack([-f_gr, -rng.integers(0, 4, (n, 3)) / 4 - np.arange(n)[:, None] * 1e-9])
+    end = rng.integers(0, 3, n)
+    survival = GoalReachabilitySurvival(reach_share=share)
+    rows, rank, crowding = survival.sort(F, end, n_survive, random_state=rng)
+    assert len(rows) == min(n, n_survive) and len(set(rows.tolist())) == len(rows)  # the population stays full
+    n_goal, n_others = int((f_gr == 1).sum()), int((f_gr != 1).sum())
+    kept_goal = int((f_gr[rows] == 1).sum())
+    quota = max(int(share * n_survive), n_survive - n_others, 1)
+    assert kept_goal == min(n_goal, quota, n_survive)  # at most the share while others can fill the rest
+    reaching_first = f_gr[rows] == 1
+    assert not (np.diff(reaching_first.astype(int)) > 0).any()  # the reaching section still ranks first
+    assert (np.diff(rank) >= 0).all()
+
+
+@pytest.mark.parametrize("share", [0, -0.5, 1.5, float("nan"), "all"])
+def test_the_reaching_share_is_validated(share):
+    with pytest.raises(ParameterError, match="reach_share"):
+        GoalReachabilitySurvival(reach_share=share)

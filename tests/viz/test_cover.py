@@ -55,12 +55,20 @@ def test_arrows_switches_and_markers_match_the_plan(case_16x7, tmp_path):
     assert crosses.get_offsets().tolist() == [[x, y] for x, y, _ in plan.uncoverable] == [[0, 0]]
     assert by_gid(ax, "start")[0].get_offsets().tolist() == [[plan.start.x, plan.start.y]]
     assert by_gid(ax, "goal")[0].get_offsets().tolist() == [[plan.goal.x, plan.goal.y]]
-    assert len([a for a in ax.patches if a.get_gid() == "borrowed rows"]) == plan.stripes_detail[-1]["borrowed"] > 0
+    assert len([a for a in ax.patches if a.get_gid() == "borrowed rows"]) == plan.stripes_detail[-1]["borrowed"]
     cuts = by_gid(ax, "region cuts")[0].get_segments()
     assert sorted({float(s[0][0]) for s in cuts}) == [3.5, 7.5, 11.5]
     path = save_figure(fig, tmp_path / "cover.png")
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     plt.close(fig)
+
+
+def test_borrowed_rows_are_hatched():
+    # the paper's variant widens 16 x 7's top stripe (Fig. 11); the default sweeps its pieces instead
+    sc = load_scenario("coverage_16x7")
+    plan = plan_coverage(sc.workspace, "O,hI", method="stripes-paper", stripes=[2, 3, 2], start=sc.start, goal=sc.goal)
+    ax = plot_cover(sc.workspace, plan).axes[0]
+    assert len([a for a in ax.patches if a.get_gid() == "borrowed rows"]) == plan.stripes_detail[-1]["borrowed"] > 0
 
 
 def test_heat_figure_has_map_and_histogram(case_16x7, tmp_path):

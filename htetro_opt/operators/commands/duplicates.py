@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pymoo.core.duplicate import DuplicateElimination
 
-__all__ = ["CommandDuplicateElimination", "chromosome_key", "first_occurrences"]
+__all__ = ["CommandDuplicateElimination", "chromosome_key", "first_occurrences", "first_keys"]
 
 
 def chromosome_key(x) -> int:
@@ -34,11 +34,22 @@ def first_occurrences(X: np.ndarray, seen: set | None = None) -> np.ndarray:
     >>> first_occurrences(as_column([[1, 2], [3], [1, 2]])).tolist()
     [0, 1]
     """
+    rows = X if isinstance(X, list) else np.asarray(X, dtype=object).reshape(len(X), -1)[:, 0]
+    return first_keys([chromosome_key(x) for x in rows], seen)
+
+
+def first_keys(keys, seen: set | None = None) -> np.ndarray:
+    """Positions of the :func:`chromosome_key` values ``keys`` that are neither in ``seen`` (updated in
+    place) nor earlier in ``keys``: :func:`first_occurrences` of chromosomes whose keys are known.
+
+    Examples
+    --------
+    >>> first_keys([5, 3, 5, 7], {7}).tolist()
+    [0, 1]
+    """
     seen = set() if seen is None else seen
     keep = []
-    rows = X if isinstance(X, list) else np.asarray(X, dtype=object).reshape(len(X), -1)[:, 0]
-    for i, x in enumerate(rows):
-        key = chromosome_key(x)
+    for i, key in enumerate(keys):
         if key not in seen:
             seen.add(key)
             keep.append(i)

@@ -7,7 +7,7 @@ from pymoo.core.survival import Survival
 from pymoo.operators.survival.rank_and_crowding import RankAndCrowding
 from pymoo.util.randomized_argsort import randomized_argsort
 
-from htetro_opt._validation import check_int
+from htetro_opt._validation import check_int, check_real
 
 __all__ = ["GoalReachabilitySurvival", "reaches_goal", "reachability_levels", "rank_and_crowding"]
 
@@ -35,14 +35,20 @@ class GoalReachabilitySurvival(Survival):
     carry ``end`` (the final pose id, set by :class:`~htetro_opt.problems.CommandPathProblem`);
     ``niche_size=0`` switches niching off (the paper's sort as written).
 
+    **Reaching share** (ours, ``reach_share``): the goal-reaching section keeps at most this share of
+    the survivors (rounded down, at least one) while individuals that do not reach the goal are left
+    to fill the rest, so that explorers survive once a first route has reached the goal. 1 (the
+    default) is the paper's sort.
+
     NSGA-II's crowding distance keeps the *least* crowded individuals of the last front; the paper's
     text says "small crowding distances", which contradicts the NSGA-II it cites, and we follow
     NSGA-II. Every survivor gets ``rank`` (0 = leading front) and ``crowding``.
     """
 
-    def __init__(self, niche_size: int = 3, nds=None, crowding_func: str = "cd") -> None:
+    def __init__(self, niche_size: int = 3, nds=None, crowding_func: str = "cd", *, reach_share: float = 1.0) -> None:
         super().__init__(filter_infeasible=True)
         self.niche_size = check_int(niche_size, "niche_size", minimum=0)
+        self.reach_share = check_real(reach_share, "reach_share", minimum=0.0, maximum=1.0, include_minimum=False)
         self.ranking = RankAndCrowding(nds=nds, crowding_func=crowding_func)
 
     def sort(self, F: np.ndarray, end: np.ndarray, n_survive: int, *,
@@ -53,11 +59,16 @@ class GoalReachabilitySurvival(Survival):
         """
         levels = reachability_levels(F, end, self.niche_size)
         rows, ranks, crowdings, n_kept, n_ranks = [], [], [], 0, 0
+        n_reaching = n_survive
+        if self.reach_share < 1.0:  # leave room for the others, as far as there are others
+            n_others = int((levels != -1.0).sum())
+            n_reaching = max(int(self.reach_share * n_survive), n_survive - n_others, 1)
         for level in np.unique(levels):  # ascending −f_gr: the highest f_gr first
             if n_kept >= n_survive:
                 break
             section = np.flatnonzero(levels == level)
-            kept, rank, crowding = rank_and_crowding(F[section], min(n_survive - n_kept, len(section)),
+            room = min(n_survive, n_reaching) if level == -1.0 else n_survive
+            kept, rank, crowding = rank_and_crowding(F[section], min(room - n_kept, len(section)),
                                                      nds=self.ranking.nds, crowding=self.ranking.crowding_func,
                                                      random_state=random_state)
             rows.append(section[kept])

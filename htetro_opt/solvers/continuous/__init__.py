@@ -5,7 +5,12 @@
   (:func:`visibility_path`): the reference of every heuristic (for r > 0, a lower and a feasible
   upper bound);
 - ``"astar"``: A* on an 8-connected lattice of spacing ``grid`` (:func:`lattice_path`), the paper's
-  grid baseline.
+  grid baseline;
+- ``"ega"``, ``"ega-paper"`` and ``"nsga2"``: Nazarahari et al. 2019's enhanced GA over path bases
+  (:func:`plan_ega`, :func:`plan_ega_paper`) and pymoo's multi-objective algorithms over the same
+  (:func:`plan_moea`), several robots planned jointly;
+- the APF of Nazarahari et al. 2019 (:func:`apf_paths`, :func:`apf_population`): the feasible
+  initial paths of its enhanced GA.
 
 Every method returns a :class:`ContinuousPlan`, re-validated against the scenario's geometry.
 """
@@ -14,7 +19,11 @@ from htetro_opt._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
     "plan_continuous": "._dispatch", "CONTINUOUS_METHODS": "._dispatch",
-    "ContinuousPlan": "._result",
+    "ContinuousPlan": "._result", "SAFETY_MARGIN": "._result", "check_scenario": "._result",
+    "check_grid": "._astar",
     "visibility_path": "._exact",
     "lattice_path": "._astar", "lattice_graph": "._astar",
+    "plan_ega": "._ega", "plan_ega_paper": "._ega", "plan_moea": "._ega", "plan_nsga2": "._ega",
+    "MOEA_ALGORITHMS": "._ega",
+    "apf_depths": "._apf", "apf_paths": "._apf", "apf_population": "._apf", "turning_points": "._apf",
 })

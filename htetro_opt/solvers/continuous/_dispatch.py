@@ -15,11 +15,14 @@ from htetro_opt.solvers.continuous._result import ContinuousPlan, check_scenario
 
 __all__ = ["CONTINUOUS_METHODS", "plan_continuous"]
 
-_METHODS = {"exact": plan_exact, "astar": plan_astar}
+_METHODS = {"exact": plan_exact, "astar": plan_astar, "ega": "plan_ega", "ega-paper": "plan_ega_paper",
+            "nsga2": "plan_nsga2"}  # the GAs load pymoo: imported when asked for
 
 CONTINUOUS_METHODS = tuple(_METHODS)
-"""Method names :func:`plan_continuous` knows: ``"exact"`` (the visibility-graph reference) and
-``"astar"`` (the lattice baseline of Nazarahari et al. 2019)."""
+"""Method names :func:`plan_continuous` knows: ``"exact"`` (the visibility-graph reference),
+``"astar"`` (the lattice baseline of Nazarahari et al. 2019), ``"ega"`` and ``"ega-paper"`` (its
+enhanced GA, with our additions or as published) and ``"nsga2"`` (pymoo's NSGA-II over the same path
+bases)."""
 
 
 def plan_continuous(scenario, *, method: str | Callable = "exact", **options) -> ContinuousPlan:
@@ -36,13 +39,20 @@ def plan_continuous(scenario, *, method: str | Callable = "exact", **options) ->
           the free space's corners: the optimum for a point robot; for r > 0 a feasible upper bound,
           with the lower bound in ``info`` (no options);
         - ``"astar"``: A* on the 8-connected lattice of spacing ``grid`` (default 1.0; the paper
-          also uses 0.25), each robot alone.
+          also uses 0.25), each robot alone;
+        - ``"ega"``: Nazarahari et al. 2019's enhanced GA over path bases with our additions, all
+          robots jointly (:func:`~htetro_opt.solvers.continuous.plan_ega`: options ``path``,
+          ``weights`` or ``normalise``, ``safety``, ``grid``, ``pop_size``, ``max_gen``, ``seed``);
+        - ``"ega-paper"``: the same GA as published (:func:`~htetro_opt.solvers.continuous.plan_ega_paper`);
+        - ``"nsga2"``: pymoo's NSGA-II over the same path bases, minimising (length, smoothness,
+          −safety); the front in ``info["front"]`` (:func:`~htetro_opt.solvers.continuous.plan_moea`:
+          options ``path``, ``safety``, ``grid``, ``pop_size``, ``max_gen``, ``seed``).
 
         Or a callable ``method(geometry, start, goal, **options)`` returning one robot's path (an
         (n, 2) array from its start to its goal) or None; it is called once per robot with the
         scenario's :class:`~htetro_opt.model.ContinuousGeometry`.
     **options
-        Keyword options of the method (``grid`` for ``"astar"``).
+        Keyword options of the method (``grid`` for ``"astar"``; see above for the GAs).
 
     Returns
     -------
@@ -57,7 +67,7 @@ def plan_continuous(scenario, *, method: str | Callable = "exact", **options) ->
         For a grid scenario (or anything but a continuous one).
     ParameterError
         On an unknown method, an option the method does not take or a bad option value (``grid`` ≤ 0
-        or above min(W, H) / 2).
+        or above min(W, H) / 2, bad weights, an unknown ``path`` or ``safety``).
     PlanningError
         If a callable method returns a path that is not an (n, 2) array from the start to the goal,
         or that collides.
@@ -82,6 +92,10 @@ def plan_continuous(scenario, *, method: str | Callable = "exact", **options) ->
         raise ParameterError(f"unknown continuous planning method {method!r}: expected one of "
                              f"{', '.join(CONTINUOUS_METHODS)} or a callable")
     function = _METHODS[method]
+    if isinstance(function, str):
+        from htetro_opt.solvers.continuous import _ega
+
+        function = getattr(_ega, function)
     known = [name for name, p in inspect.signature(function).parameters.items() if p.kind is p.KEYWORD_ONLY]
     unknown = sorted(set(options) - set(known))
     if unknown:

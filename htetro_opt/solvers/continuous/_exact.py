@@ -33,7 +33,7 @@ def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 
 def visibility_path(geometry: ContinuousGeometry, start, goal, *,
-                    corners: Corners | None = None) -> tuple[np.ndarray | None, float]:
+                    corners: Corners | None = None, prune=None) -> tuple[np.ndarray | None, float]:
     """The shortest path from ``start`` to ``goal`` that bends only at ``corners``, every segment
     feasible in ``geometry``.
 
@@ -46,6 +46,12 @@ def visibility_path(geometry: ContinuousGeometry, start, goal, *,
     corners : Corners, keyword-only
         Where the path may bend; by default the geometry's own corners (r = 0) or those of its outer
         polygonisation (r > 0).
+    prune : callable, keyword-only, optional
+        ``prune(points, i, j) -> mask``: which of the candidate segments points[i] – points[j]
+        (tangent ones, start and goal at rows 0 and 1, then the corners) are tested at all; a
+        caller that knows most of them are blocked (taut refinement: segments between points far
+        apart along a path) saves their feasibility tests. The result is then shortest over what
+        is kept.
 
     Returns
     -------
@@ -79,6 +85,9 @@ def visibility_path(geometry: ContinuousGeometry, start, goal, *,
         c2 = _cross(line, after[end] - points[end])
         mask &= (end < 2) | (c1 * c2 >= 0)
     i, j = i[mask], j[mask]
+    if prune is not None:
+        keep = np.asarray(prune(points, i, j), dtype=bool)
+        i, j = i[keep], j[keep]
     ok = geometry.segments_feasible(points[i], points[j])
     i, j = i[ok], j[ok]
     weights = np.hypot(*(points[j] - points[i]).T)

@@ -1,34 +1,43 @@
-"""Cheng et al. 2019's stripe coverage (§III–IV): stripes, regions and one auxiliary DAG.
+"""Cheng et al. 2019's stripe coverage (§III–IV): stripes, their pieces, regions and one auxiliary DAG.
 
 Our reading of the paper, where it is ambiguous or contradicts itself:
 
-- **Stripes** (Def. 6–7) are bands of rows stacked from y = 0, swept +x in the first, −x in the
-  second, … (a boustrophedon of bands). A vertex belongs to stripe k when its whole footprint lies in
-  k's rows (Def. 6 uses B2's cell; with footprints, a stripe's cost does not depend on its
-  neighbours). **Widening** (Alg. 5 l. 14): when no connected piece of a stripe's vertices covers all
-  the coverable cells of its own rows, rows are borrowed one at a time, the previous stripe's first,
-  at most as many as the stripe has; the widening that leaves fewest of its cells out wins (ties:
-  fewer rows). The stripe then keeps every connected piece that leaves out that fewest (not only
-  one: at the map's top edge the vertical I cannot switch to the O, yet each covers the whole
-  stripe, and a cut-edge in its own layer enters it); its targets stay its own rows' cells.
-- **Ports and cut-edges** (Def. 8–9): per layer and piece, the exit port is the layer's vertex at the
-  sweep end (extreme x), y nearest the next stripe; the next stripe's entry port likewise at the same
-  end, y nearest the previous stripe; the cut-edge cost is the fewest translations in that layer
-  through both bands (no edge if none).
-- **Regions** (§IV-B): each stripe is cut every ``region_columns`` columns along its sweep; the ports
-  at a cut are the stripe's vertices with B2 in the cut column (a cut without any is dropped). A
-  region may use the stripe's vertices with B2 up to 3 columns outside it and must cover the targets
+- **Stripes** (Def. 6–7) are bands of rows stacked from y = 0. A vertex belongs to stripe k when its
+  whole footprint lies in k's rows (Def. 6 uses B2's cell; with footprints, a stripe's cost does not
+  depend on its neighbours).
+- **Pieces.** A wall or a piece of furniture splits a stripe's vertices into connected pieces (and
+  at the map's top edge the vertical I cannot switch to the O). Pieces covering the same targets are
+  alternatives of one *sweep* (each entered by its own ports); a piece covering targets no larger
+  piece covers is a sweep of its own. Each sweep is one vertex chain of the DAG (ports, regions,
+  ports), consecutive sweeps joined by transit legs: shortest paths in the workspace graph (the
+  paper's variant joins consecutive stripes by its cut-edges, one layer through both bands, Def. 9,
+  where they exist). The sweeps are taken greedily, each the one whose entry is nearest the last
+  one's exit, in either direction (ties: the lower stripe, the direction opposite to the last): on a
+  map without splits this is the paper's boustrophedon of stripes (+x, −x, …); a room behind a
+  doorway is covered whole before the robot goes back through it.
+- **Widening** (Alg. 5 l. 14): when some of a stripe's targets lie under no vertex of its band, rows
+  are borrowed one at a time, the previous stripe's first, at most as many as the stripe has (the
+  band that leaves fewest out wins, then the narrowest). The paper also widens a stripe whose exit
+  is unreachable (a split stripe) until one piece covers it; our default variant plans both ways,
+  split stripes swept piece by piece or widened, and keeps the cheaper plan (:func:`plan_stripes`).
+  A sweep's targets stay its own rows' cells.
+- **Ports and joins** (Def. 8–9): per piece and layer, the vertices at the sweep's x end with the
+  lowest and the highest y are its ports (entry at the start end, exit at the far end).
+- **Regions** (§IV-B): each sweep is cut every ``region_columns`` columns along its direction; the
+  ports at a cut are the sweep's vertices with B2 in the cut column (a cut without any is dropped).
+  A region may use the sweep's vertices with B2 up to 3 columns outside it and must cover the targets
   in its columns reachable from its entry in that window; the rest is left to the mop-up.
-- **One DAG** (eq. 8, typos fixed): start, ports, cut-edges and goal are the nodes of one
+- **One DAG** (eq. 8, typos fixed): start, ports, cuts, joins and goal are the nodes of one
   ``networkx.DiGraph``; a region edge costs its search's cost (``_rbt``), computed lazily by the
   weight callable of ``nx.single_source_dijkstra`` and memoised by the region's content (its window
   of vertices and edges relative to the window, targets, entry and exit), not by a cell (Alg. 1's
   ``WT`` keys by the vertex's cell only, which mixes different costs).
-- **Start, goal, transits, mop-up**: a start outside the first stripe reaches its entry ports (a goal
-  outside the last stripe is reached from its exit ports) by shortest paths in the workspace graph;
-  without a goal the plan ends where the last region does. Cells the stripes leave uncovered are
-  visited nearest-first afterwards (mop-up), and the plan then returns to the goal if there is one.
-  If the DAG has no path at all, the whole map is covered by the mop-up walk from the start.
+- **Start, goal, mop-up**: the first sweep is in the lowest stripe (the one holding the start, else
+  the nearest); a start outside it reaches its entry ports (a goal outside the last sweep is reached
+  from its exit ports) by shortest paths; without a goal the plan ends where the last region does.
+  Cells the sweeps leave uncovered are visited nearest-first afterwards (mop-up), and the plan then
+  returns to the goal if there is one. If the DAG has no path at all, the whole map is covered by the
+  mop-up walk from the start.
 """
 
 from __future__ import annotations
@@ -85,16 +94,20 @@ def stripe_widths(stripes, height: int, name: str = "stripes") -> tuple[int, ...
 
 
 @dataclass
-class _Stripe:
-    own: tuple[int, int]  # own rows [low, high)
+class _Sweep:
+    """One chain of the DAG: a stripe's piece (or its alternative pieces), swept along one direction."""
+
+    stripe: int  # the stripe's index, bottom up
+    own: tuple[int, int]  # the stripe's own rows [low, high)
     band: tuple[int, int]  # rows with the borrowed ones
-    nodes: np.ndarray  # vertices of its connected pieces that leave out fewest targets
-    targets: np.ndarray  # flat coverable cells of its own rows
+    pieces: list  # alternative connected pieces covering the same targets, each its vertices
+    nodes: np.ndarray  # their union
+    targets: np.ndarray  # flat coverable cells of the stripe's own rows this sweep must cover
     direction: int = 1  # +1: sweep +x, −1: −x
     blocks: list = field(default_factory=list)  # region columns [c0, c1) in sweep order
     cuts: list = field(default_factory=list)  # ports (vertices) at each cut between blocks
     cost: int = 0
-    pieces: list = field(default_factory=list)  # those pieces, each its vertices
+    key: int = 0  # unique per sweep: region searches are cached by it
 
 
 @dataclass
@@ -118,10 +131,14 @@ def shortest_path(lg: LayerGraph, source: int, target: int, matrix=None) -> tupl
     dist, pred = dijkstra(lg.matrix if matrix is None else matrix, indices=source, return_predecessors=True)
     if not math.isfinite(dist[target]):
         return math.inf, []
+    return float(dist[target]), _walk_back(pred, source, target)
+
+
+def _walk_back(pred, source: int, target: int) -> list[int]:
     path = [target]
     while path[-1] != source:
         path.append(int(pred[path[-1]]))
-    return float(dist[target]), path[::-1]
+    return path[::-1]
 
 
 def mop_up(lg: LayerGraph, path: list[int], coverable: np.ndarray, reachable: np.ndarray) -> list[int]:
@@ -140,10 +157,7 @@ def mop_up(lg: LayerGraph, path: list[int], coverable: np.ndarray, reachable: np
         goal = int(np.argmin(cost))
         if not math.isfinite(cost[goal]):
             break  # cannot happen for coverable cells: they are under reachable vertices
-        leg = [goal]
-        while leg[-1] != cur:
-            leg.append(int(pred[leg[-1]]))
-        leg = leg[::-1][1:]
+        leg = _walk_back(pred, cur, goal)[1:]
         covered[lg.footprint[leg].ravel()] = True
         added += leg
         cur = goal
@@ -152,7 +166,8 @@ def mop_up(lg: LayerGraph, path: list[int], coverable: np.ndarray, reachable: np
 
 class _Planner:
     def __init__(self, lg: LayerGraph, cov: Coverability, start: int, goal: int | None, widths, *,
-                 region_columns: int, budget: int, deadline: float | None, memo: bool, paper: bool = False) -> None:
+                 region_columns: int, budget: int, deadline: float | None, memo: bool, paper: bool = False,
+                 widening: str = "split") -> None:
         self.lg, self.cov, self.start, self.goal, self.paper = lg, cov, start, goal, paper
         self.region_columns, self.budget, self.deadline, self.use_memo = region_columns, budget, deadline, memo
         n = lg.n_nodes
@@ -167,41 +182,82 @@ class _Planner:
         self.results: dict = {}
         self.stats = {"regions": 0, "optimal": 0, "memo_hits": 0, "nodes": 0}
         self.time_limited = False
+        self._keys = 0
         lows = np.cumsum((0,) + tuple(widths))
-        self.stripes: list[_Stripe] = []
+        self.bands: list[tuple[tuple[int, int], tuple[int, int]]] = []  # (own rows, band) per stripe kept
+        self.widening, self.choices = widening, 0  # stripes where splitting and widening both apply
+        sweeps: list[_Sweep] = []
         for lo, hi in zip(lows[:-1], lows[1:]):
-            stripe = self._widen(int(lo), int(hi))
-            if len(stripe.nodes):
-                self.stripes.append(stripe)
-        for i, stripe in enumerate(self.stripes):
-            stripe.direction = 1 if i % 2 == 0 else -1
-            self._regions(stripe)
+            own = (int(lo), int(hi))
+            options = self._widen(*own)
+            self.choices += len(options) > 1
+            band, found = options[0] if widening == "split" else options[-1]
+            mine = self._sweeps(len(self.bands), own, band, found)
+            if mine:
+                sweeps += mine
+                self.bands.append((own, band))
+        self.sweeps = self._order(sweeps)
+        for sweep in self.sweeps:
+            self._regions(sweep)
 
-    # --- stripes ------------------------------------------------------------------------------
-    def _piece(self, band: tuple[int, int], targets: np.ndarray) -> tuple[int, np.ndarray, list]:
-        """(targets left out, vertices) of the band's connected pieces that leave out fewest: all of
-        them, since each can be entered by its own layer's cut-edge (in the top stripe of a free map
-        the vertical I cannot switch to the O, yet both cover the whole stripe)."""
+    # --- stripes and their pieces ---------------------------------------------------------------
+    def _split(self, band: tuple[int, int], targets: np.ndarray) -> tuple[int, list]:
+        """The band's sweeps: (targets no piece covers, [(alternative pieces, their targets)]).
+
+        The band's vertices fall into connected pieces (a wall or a piece of furniture splits a stripe;
+        at the map's top edge the vertical I cannot switch to the O). Pieces covering the same targets
+        are alternatives of one sweep (each entered by its own layer's port); a piece covering targets
+        no larger piece covers is a sweep of its own, for its new targets; the rest are dropped.
+        """
         lo, hi = band
         idx = np.flatnonzero(self.reach & (self.ylo >= lo) & (self.yhi < hi))
-        if not len(idx):
-            return len(targets), idx, []
-        _, labels = connected_components(self.lg.matrix[idx][:, idx], directed=False)
-        hw = self.lg.width * self.lg.height
-        missing = {}
-        for label in np.unique(labels).tolist():
-            covered = np.zeros(hw, dtype=bool)
-            covered[self.lg.footprint[idx[labels == label]].ravel()] = True
-            missing[label] = int((~covered[targets]).sum())
-        fewest = min(missing.values())
-        keep = [label for label, m in missing.items() if m == fewest]
-        return fewest, idx[np.isin(labels, keep)], [idx[labels == label] for label in keep]
+        if not len(idx) or not len(targets):
+            return len(targets), []
+        n, labels = connected_components(self.lg.matrix[idx][:, idx], directed=False)
+        where = np.full(self.lg.width * self.lg.height, -1)
+        where[targets] = np.arange(len(targets))
+        hit = where[self.lg.footprint[idx]]  # (V, 4) target index or −1
+        masks = np.zeros((n, len(targets)), dtype=bool)
+        rows = np.repeat(labels, 4)
+        keep = hit.ravel() >= 0
+        masks[rows[keep], hit.ravel()[keep]] = True
+        counts = masks.sum(axis=1)
+        groups: list[tuple[list[int], np.ndarray, np.ndarray]] = []  # (labels, mask, new targets)
+        claimed = np.zeros(len(targets), dtype=bool)
+        for c in np.lexsort((np.arange(n), -counts)).tolist():
+            if counts[c] == 0:
+                break
+            same = next((g for g in groups if (g[1] == masks[c]).all()), None)
+            if same is not None:
+                same[0].append(c)
+            elif (masks[c] & ~claimed).any():
+                groups.append(([c], masks[c], masks[c] & ~claimed))
+                claimed |= masks[c]
+        found = [([idx[labels == c] for c in labs], targets[new]) for labs, _, new in groups]
+        return int((~claimed).sum()), found
 
-    def _widen(self, lo: int, hi: int) -> _Stripe:
+    def _sweeps(self, stripe: int, own, band, found) -> list[_Sweep]:
+        made = []
+        for pieces, targets in found:
+            self._keys += 1
+            made.append(_Sweep(stripe, own, band, pieces, np.unique(np.concatenate(pieces)), targets, key=self._keys))
+        return made
+
+    def _widen(self, lo: int, hi: int) -> list:
+        """The stripe's candidate (band, sweeps), cheapest first to try.
+
+        Widening (Alg. 5 l. 14): rows are borrowed one at a time (the previous stripe's first), at
+        most as many as the stripe has. Two reasons to borrow: targets under no vertex of the band
+        (the band leaving fewest out wins, then the narrowest), and the stripe split into pieces (the
+        first band with one piece covering all its targets). The first always applies; the second is
+        the paper's ("the exit is unreachable"); our default variant also sweeps the split stripe's
+        pieces apart, joined by transit legs, and keeps the cheaper plan (:func:`plan_stripes`).
+        Returns [split, joined] when they differ, else the one candidate.
+        """
         cells = np.arange(lo * self.lg.width, hi * self.lg.width)
         targets = cells[self.coverable[cells]]
         bands, low, high = [(lo, hi)], lo, hi
-        for _ in range(hi - lo):  # at most as many rows as the stripe has, the previous stripe's first
+        for _ in range(hi - lo):
             if low > 0:
                 low -= 1
             elif high < self.lg.height:
@@ -209,43 +265,145 @@ class _Planner:
             else:
                 break
             bands.append((low, high))
-        best = None
+        best, joined = None, None
         for band in bands:
-            missing, nodes, pieces = self._piece(band, targets)
+            missing, found = self._split(band, targets)
             if best is None or missing < best[0]:
-                best = (missing, band, nodes, pieces)
-            if missing == 0:
+                best = (missing, band, found)
+            if len(found) == 1 and missing == 0:
+                joined = (band, found)
                 break
-        return _Stripe((lo, hi), best[1], best[2], targets, pieces=best[3])
+        if joined is None:
+            return [best[1:]]
+        if self.paper or joined[0] == best[1]:
+            return [joined]
+        return [best[1:], joined]
 
-    def _forced(self, stripe: _Stripe) -> np.ndarray:
-        """The stripe's forced poses: the only vertex of the stripe covering some target."""
+    def _split(self, band: tuple[int, int], targets: np.ndarray) -> tuple[int, list]:
+        """The band's sweeps: (targets no piece covers, [(alternative pieces, their targets)]).
+
+        The band's vertices fall into connected pieces (a wall or a piece of furniture splits a stripe;
+        at the map's top edge the vertical I cannot switch to the O). Pieces covering the same targets
+        are alternatives of one sweep (each entered by its own layer's port); a piece covering targets
+        no larger piece covers is a sweep of its own, for its new targets; the rest are dropped.
+        """
+        lo, hi = band
+        idx = np.flatnonzero(self.reach & (self.ylo >= lo) & (self.yhi < hi))
+        if not len(idx) or not len(targets):
+            return len(targets), []
+        n, labels = connected_components(self.lg.matrix[idx][:, idx], directed=False)
+        where = np.full(self.lg.width * self.lg.height, -1)
+        where[targets] = np.arange(len(targets))
+        hit = where[self.lg.footprint[idx]]  # (V, 4) target index or −1
+        masks = np.zeros((n, len(targets)), dtype=bool)
+        rows = np.repeat(labels, 4)
+        keep = hit.ravel() >= 0
+        masks[rows[keep], hit.ravel()[keep]] = True
+        counts = masks.sum(axis=1)
+        groups: list[tuple[list[int], np.ndarray, np.ndarray]] = []  # (labels, mask, new targets)
+        claimed = np.zeros(len(targets), dtype=bool)
+        for c in np.lexsort((np.arange(n), -counts)).tolist():
+            if counts[c] == 0:
+                break
+            same = next((g for g in groups if (g[1] == masks[c]).all()), None)
+            if same is not None:
+                same[0].append(c)
+            elif (masks[c] & ~claimed).any():
+                groups.append(([c], masks[c], masks[c] & ~claimed))
+                claimed |= masks[c]
+        found = [([idx[labels == c] for c in labs], targets[new]) for labs, _, new in groups]
+        return int((~claimed).sum()), found
+
+    def _sweeps(self, stripe: int, own, band, found) -> list[_Sweep]:
+        made = []
+        for pieces, targets in found:
+            self._keys += 1
+            made.append(_Sweep(stripe, own, band, pieces, np.unique(np.concatenate(pieces)), targets, key=self._keys))
+        return made
+
+    def _widen(self, lo: int, hi: int) -> list:
+        """The stripe's candidate (band, sweeps), cheapest first to try.
+
+        Widening (Alg. 5 l. 14): rows are borrowed one at a time (the previous stripe's first), at
+        most as many as the stripe has. Two reasons to borrow: targets under no vertex of the band
+        (the band leaving fewest out wins, then the narrowest), and the stripe split into pieces (the
+        first band with one piece covering all its targets). The first always applies; the second is
+        the paper's ("the exit is unreachable"); our default variant also sweeps the split stripe's
+        pieces apart, joined by transit legs, and keeps the cheaper plan (:func:`plan_stripes`).
+        Returns [split, joined] when they differ, else the one candidate.
+        """
+        cells = np.arange(lo * self.lg.width, hi * self.lg.width)
+        targets = cells[self.coverable[cells]]
+        bands, low, high = [(lo, hi)], lo, hi
+        for _ in range(hi - lo):
+            if low > 0:
+                low -= 1
+            elif high < self.lg.height:
+                high += 1
+            else:
+                break
+            bands.append((low, high))
+        best, joined = None, None
+        for band in bands:
+            missing, found = self._split(band, targets)
+            if best is None or missing < best[0]:
+                best = (missing, band, found)
+            if len(found) == 1 and missing == 0:
+                joined = (band, found)
+                break
+        if joined is None:
+            return [best[1:]]
+        if self.paper or joined[0] == best[1]:
+            return [joined]
+        return [best[1:], joined]
+
+    def _cheaper(self, options: list):
+        """Of a stripe's candidate (band, sweeps), the one whose sweeps cost least alone (swept +x in
+        x order, either way, any port in and out: the same DAG and region searches as the plan's;
+        ties: the first, the split stripe, whose pieces the plan may order as it goes)."""
+        best = None
+        for band, sweeps in options:
+            cost = math.inf
+            for direction in (1, -1):
+                for sweep in sweeps:
+                    sweep.direction = direction
+                    self._regions(sweep)
+                chain = sorted(sweeps, key=lambda sw: -direction * int(self.bx[sw.nodes].max()))[::-1]
+                found, _ = self._solve(self.dag(chain, start=None, goal=None))
+                cost = min(cost, math.inf if found is None else found)
+            if best is None or cost < best[0]:
+                best = (cost, band, sweeps)
+        self.choices["widened" if best[2] is options[-1][1] else "split"] += 1
+        return best[1], best[2]
+
+    def _forced(self, sweep: _Sweep) -> np.ndarray:
+        """The sweep's forced poses: the only vertex of the sweep covering some target."""
         hw = self.lg.width * self.lg.height
-        fp = self.lg.footprint[stripe.nodes]  # (V, 4)
-        hits = np.zeros((len(stripe.nodes), hw), dtype=bool)
-        hits[np.repeat(np.arange(len(stripe.nodes)), 4), fp.ravel()] = True
-        hits = hits[:, stripe.targets]
+        fp = self.lg.footprint[sweep.nodes]  # (V, 4)
+        hits = np.zeros((len(sweep.nodes), hw), dtype=bool)
+        hits[np.repeat(np.arange(len(sweep.nodes)), 4), fp.ravel()] = True
+        hits = hits[:, sweep.targets]
         lonely = hits.sum(axis=0) == 1
-        return stripe.nodes[np.flatnonzero(hits[:, lonely].any(axis=1))]
+        return sweep.nodes[np.flatnonzero(hits[:, lonely].any(axis=1))]
 
-    def _regions(self, stripe: _Stripe) -> None:
+    def _regions(self, sweep: _Sweep) -> None:
         w, rc = self.lg.width, self.region_columns
-        forced = self._forced(stripe) if self.paper else None
+        forced = self._forced(sweep) if self.paper else None
         if self.paper:  # cut only at forced poses: blocks start at their columns, along the sweep
             edges = [c for c in sorted(set(self.bx[forced].tolist())) if 0 < c < w]
-            if stripe.direction < 0:
+            if sweep.direction < 0:
                 edges = [c + 1 for c in edges if c + 1 < w]
             bounds = [0] + sorted(set(edges)) + [w]
             blocks = [(a, b) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
         else:
             blocks = [(c, min(c + rc, w)) for c in range(0, w, rc)]
-        if stripe.direction < 0:
+        if sweep.direction < 0:
             blocks = blocks[::-1] if self.paper else [(w - c1, w - c0) for c0, c1 in blocks]
-        bx = self.bx[stripe.nodes]
+        bx = self.bx[sweep.nodes]
         merged, cuts = [blocks[0]], []
         for block in blocks[1:]:
-            column = block[0] if stripe.direction > 0 else block[1] - 1
-            ports = stripe.nodes[bx == column]
+            column = block[0] if sweep.direction > 0 else block[1] - 1
+            ports = sweep.nodes[bx == column]
             if self.paper:
                 ports = ports[np.isin(ports, forced)]
             if len(ports):
@@ -254,19 +412,54 @@ class _Planner:
             else:  # no vertex to cut at: this block joins the previous one
                 c0, c1 = merged[-1]
                 merged[-1] = (min(c0, block[0]), max(c1, block[1]))
-        stripe.blocks, stripe.cuts = merged, cuts
+        sweep.blocks, sweep.cuts = merged, cuts
 
-    def _ports(self, stripe: _Stripe, layer: int, end: int, toward: int) -> list[int]:
-        """Per connected piece of the stripe, the layer's vertex at the x end ``end`` (+1: max x), y
-        extreme ``toward`` (+1: max y)."""
+    def _ports(self, sweep: _Sweep, end: int, toward: tuple[int, ...] = (-1, 1)) -> list[int]:
+        """Per piece and layer, the vertices at the x end ``end`` (+1: max x) with the y extremes
+        ``toward`` (+1: max y): the ports a sweep is entered or left by."""
         hw = self.lg.width * self.lg.height
         ports = []
-        for piece in stripe.pieces:
-            nodes = piece[piece // hw == layer]
-            if len(nodes):
-                key = np.lexsort((-toward * self.by[nodes], -end * self.bx[nodes]))
-                ports.append(int(nodes[key[0]]))
-        return ports
+        for piece in sweep.pieces:
+            for layer in range(self.lg.n_layers):
+                nodes = piece[piece // hw == layer]
+                for t in toward:
+                    if len(nodes):
+                        key = np.lexsort((-t * self.by[nodes], -end * self.bx[nodes]))
+                        ports.append(int(nodes[key[0]]))
+        return list(dict.fromkeys(ports))
+
+    def _order(self, sweeps: list[_Sweep]) -> list[_Sweep]:
+        """The sweeps in the order the DAG chains them, each with its direction.
+
+        The first is in the lowest stripe: the one holding the start (swept +x), else the one whose
+        entry is nearest the start. Then, greedily, the sweep (and direction) whose entry is nearest
+        the last one's exit (ties: the lower stripe, the direction opposite to the last, the piece
+        listed first): on a map without splits that is the boustrophedon of stripes, and pieces
+        split by a wall are swept where the robot is, not in stripe order (a room behind a doorway is
+        covered whole before the robot goes back through it)."""
+        if not sweeps:
+            return []
+        matrix = self.lg.matrix
+        ports = {(i, d): (self._ports(s, -d), self._ports(s, d)) for i, s in enumerate(sweeps) for d in (1, -1)}
+        lowest = min(s.stripe for s in sweeps)
+        holding = [i for i, s in enumerate(sweeps) if s.stripe == lowest and self.start in set(s.nodes.tolist())]
+        if holding:
+            here = (holding[0], 1)
+        else:
+            dist = dijkstra(matrix, indices=self.start)
+            here = min(((i, d) for i, s in enumerate(sweeps) if s.stripe == lowest for d in (1, -1)),
+                       key=lambda k: (dist[ports[k][0]].min(), -k[1], k[0]))
+        order, left = [], set(range(len(sweeps)))
+        while True:
+            i, d = here
+            sweeps[i].direction = d
+            order.append(sweeps[i])
+            left.discard(i)
+            if not left:
+                return order
+            dist = dijkstra(matrix, indices=ports[here][1], min_only=True)
+            here = min(((j, e) for j in left for e in (1, -1)),
+                       key=lambda k: (dist[ports[k][0]].min(), sweeps[k[0]].stripe, k[1] == d, k[0]))
 
     def _translations(self, layer: int, rows: tuple[int, int]):
         hw = self.lg.width * self.lg.height
@@ -275,12 +468,12 @@ class _Planner:
         return keep, self.lg.matrix[keep][:, keep]
 
     # --- regions ------------------------------------------------------------------------------
-    def _problem(self, s: int, b: int, entry: int, exits: list[int]):
-        """The region problem of block b of stripe s from ``entry``: (nodes, Region, memo key)."""
-        key = (s, b, entry)
+    def _problem(self, stripe: _Sweep, b: int, entry: int, exits: list[int]):
+        """The region problem of block b of a sweep from ``entry``: (nodes, Region, memo key)."""
+        key = (stripe.key, stripe.direction, b, entry)
         if key in self.problems:
             return self.problems[key]
-        stripe, lg = self.stripes[s], self.lg
+        lg = self.lg
         c0, c1 = stripe.blocks[b]
         xs = [self.bx[entry]] + [self.bx[e] for e in exits if e >= 0]
         margin = lg.width if self.paper else WINDOW_MARGIN  # the paper's regions: the whole stripe
@@ -318,11 +511,11 @@ class _Planner:
         self.problems[key] = (nodes, region, memo_key)
         return self.problems[key]
 
-    def region_cost(self, s: int, b: int, entry: int, exit: int, exits: list[int]) -> float | None:
-        """Cost of block b of stripe s from entry to exit (−1: a free end), None if impossible."""
-        key = (s, b, entry, exit)
+    def region_cost(self, sweep: _Sweep, b: int, entry: int, exit: int, exits: list[int]) -> float | None:
+        """Cost of block b of a sweep from entry to exit (−1: a free end), None if impossible."""
+        key = (sweep.key, sweep.direction, b, entry, exit)
         if key not in self.results:
-            nodes, region, memo_key = self._problem(s, b, entry, exits)
+            nodes, region, memo_key = self._problem(sweep, b, entry, exits)
             local = {int(v): i for i, v in enumerate(nodes)}
             if exit >= 0 and exit not in local:
                 self.results[key] = None
@@ -349,80 +542,107 @@ class _Planner:
         return None if found is None else found[0]
 
     # --- the DAG ------------------------------------------------------------------------------
-    def dag(self) -> nx.DiGraph:
+    def _legs(self, g: nx.DiGraph, outs: list[int], intos: list[int], tail, head, a=None, b=None) -> list[int]:
+        """Fixed edges from the ports ``outs`` (DAG nodes ``tail(v)``) to the ports ``intos`` (``head(v)``):
+        shortest paths in the workspace graph. The paper's variant joins consecutive stripes by its
+        cut-edges (translations in one layer through both bands, Def. 9) and falls back on those paths
+        only where a stripe's pieces have none. Returns the ports reached."""
+        reached = []
+        if self.paper and a is not None and b.stripe == a.stripe + 1:
+            rows = (min(a.band[0], b.band[0]), max(a.band[1], b.band[1]))
+            hw = self.lg.width * self.lg.height
+            for layer in range(self.lg.n_layers):
+                ins = [v for v in intos if v // hw == layer]
+                if not ins:
+                    continue
+                keep, matrix = self._translations(layer, rows)
+                for out in (v for v in outs if v // hw == layer):
+                    dist, pred = dijkstra(matrix, indices=int(np.searchsorted(keep, out)), return_predecessors=True)
+                    for into in ins:
+                        k = int(np.searchsorted(keep, into))
+                        if math.isfinite(dist[k]):
+                            path = [int(keep[v]) for v in _walk_back(pred, int(np.searchsorted(keep, out)), k)]
+                            g.add_edge(tail(out), head(into), kind="fixed", cost=dist[k], path=path)
+                            reached.append(into)
+            if reached:
+                return list(dict.fromkeys(reached))
+        for out in outs:
+            dist, pred = dijkstra(self.lg.matrix, indices=out, return_predecessors=True)
+            for into in intos:
+                if math.isfinite(dist[into]):
+                    g.add_edge(tail(out), head(into), kind="fixed", cost=dist[into],
+                               path=_walk_back(pred, out, into))
+                    reached.append(into)
+        return list(dict.fromkeys(reached))
+
+    def dag(self, chain: list[_Sweep], *, start: int | None, goal) -> nx.DiGraph:
+        """The auxiliary DAG of a chain of sweeps: "S" (the start vertex, or every entry port of the
+        first sweep at no cost when None), ports, cuts and joins, then "G" (the goal vertex, or a free
+        end when None)."""
         g = nx.DiGraph()
-        lg, last = self.lg, len(self.stripes) - 1
-        first = self.stripes[0]
-        if self.start in set(first.nodes.tolist()):
-            entries = [self.start]
-            g.add_edge("S", (0, -1, self.start), kind="fixed", cost=0, path=[self.start])
+        last = len(chain) - 1
+        first = chain[0]
+        if start is None:
+            entries = self._ports(first, -first.direction)
+            for v in entries:
+                g.add_edge("S", (0, -1, v), kind="fixed", cost=0, path=[v])
+        elif start in set(first.nodes.tolist()):
+            entries = [start]
+            g.add_edge("S", (0, -1, start), kind="fixed", cost=0, path=[start])
         else:
-            entries = []
-            for layer in range(lg.n_layers):
-                for port in self._ports(first, layer, -first.direction, -1):
-                    cost, path = shortest_path(lg, self.start, port)
-                    if math.isfinite(cost):
-                        entries.append(port)
-                        g.add_edge("S", (0, -1, port), kind="fixed", cost=cost, path=path)
-        for s, stripe in enumerate(self.stripes):
-            levels = [entries] + [c.tolist() for c in stripe.cuts]
+            entries = self._legs(g, [start], self._ports(first, -first.direction), lambda v: "S",
+                                 lambda v: (0, -1, v))
+        for s, sweep in enumerate(chain):
+            levels = [entries] + [c.tolist() for c in sweep.cuts]
+            end = len(levels) - 1
             if s < last:
-                nxt = self.stripes[s + 1]
-                exits, next_entries = [], []
-                rows = (min(stripe.band[0], nxt.band[0]), max(stripe.band[1], nxt.band[1]))
-                for layer in range(lg.n_layers):
-                    outs = self._ports(stripe, layer, stripe.direction, 1)
-                    intos = self._ports(nxt, layer, stripe.direction, -1)
-                    if not outs or not intos:
-                        continue
-                    keep, matrix = self._translations(layer, rows)
-                    for out in outs:
-                        for into in intos:
-                            cost, path = shortest_path(lg, int(np.searchsorted(keep, out)),
-                                                       int(np.searchsorted(keep, into)), matrix)
-                            if math.isfinite(cost):
-                                exits.append(out)
-                                next_entries.append(into)
-                                g.add_edge((s, len(levels) - 1, out), (s + 1, -1, into), kind="fixed", cost=cost,
-                                           path=[int(keep[v]) for v in path])
-                exits, entries = list(dict.fromkeys(exits)), list(dict.fromkeys(next_entries))
-            elif self.goal is None:
+                nxt = chain[s + 1]
+                outs = self._ports(sweep, sweep.direction)
+                entries = self._legs(g, outs, self._ports(nxt, -nxt.direction), lambda v: (s, end, v),
+                                     lambda v: (s + 1, -1, v), sweep, nxt)
+                exits = [v for v in outs if g.has_node((s, end, v))]
+            elif goal is None:
                 exits = [-1]
-                g.add_edge((s, len(levels) - 1, -1), "G", kind="fixed", cost=0, path=[])
-            elif self.goal in set(stripe.nodes.tolist()):
-                exits = [self.goal]
-                g.add_edge((s, len(levels) - 1, self.goal), "G", kind="fixed", cost=0, path=[self.goal])
+                g.add_edge((s, end, -1), "G", kind="fixed", cost=0, path=[])
+            elif goal in set(sweep.nodes.tolist()):
+                exits = [goal]
+                g.add_edge((s, end, goal), "G", kind="fixed", cost=0, path=[goal])
             else:
-                exits = []
-                for layer in range(lg.n_layers):
-                    for out in self._ports(stripe, layer, stripe.direction, 1):
-                        cost, path = shortest_path(lg, out, self.goal)
-                        if math.isfinite(cost):
-                            exits.append(out)
-                            g.add_edge((s, len(levels) - 1, out), "G", kind="fixed", cost=cost, path=path)
+                outs = self._ports(sweep, sweep.direction)
+                self._legs(g, outs, [goal], lambda v: (s, end, v), lambda v: "G")
+                exits = [v for v in outs if g.has_node((s, end, v))]
             levels.append(exits)
-            for b in range(len(stripe.blocks)):
+            for b in range(len(sweep.blocks)):
                 for p in levels[b]:
                     for q in levels[b + 1]:
-                        g.add_edge((s, b - 1, p), (s, b, q), kind="region", block=(s, b), exits=levels[b + 1])
+                        g.add_edge((s, b - 1, p), (s, b, q), kind="region", sweep=sweep, block=b,
+                                   exits=levels[b + 1])
         return g
 
-    def plan(self) -> StripeOutcome:
-        g = self.dag()
-
+    def _solve(self, g: nx.DiGraph):
+        """(cost, node path) of the DAG's shortest S → G path, region costs computed lazily; (None, None)
+        if there is none."""
         def weight(u, v, data):
             if data["kind"] == "fixed":
                 return data["cost"]
-            s, b = data["block"]
-            return self.region_cost(s, b, u[2], v[2], data["exits"])
+            return self.region_cost(data["sweep"], data["block"], u[2], v[2], data["exits"])
 
-        info: dict = {"dag_nodes": g.number_of_nodes(), "dag_edges": g.number_of_edges()}
+        if "S" not in g or "G" not in g:
+            return None, None
         try:
-            dag_cost, dag_path = nx.single_source_dijkstra(g, "S", "G", weight=weight) if "S" in g and "G" in g \
-                else (None, None)
+            return nx.single_source_dijkstra(g, "S", "G", weight=weight)
         except nx.NetworkXNoPath:
-            dag_cost, dag_path = None, None
-        path, transit = [self.start], 0
+            return None, None
+
+    def plan(self) -> StripeOutcome:
+        info: dict = {"sweeps": len(self.sweeps)}
+        if not self.sweeps:
+            info["dag"] = "no stripe has a piece: the whole map is covered by the mop-up walk"
+            return self._outcome([self.start], None, 0, info)
+        g = self.dag(self.sweeps, start=self.start, goal=self.goal)
+        info.update({"dag_nodes": g.number_of_nodes(), "dag_edges": g.number_of_edges()})
+        dag_cost, dag_path = self._solve(g)
+        path, joins = [self.start], 0
         if dag_path is None:
             info["dag"] = "no path: the whole map is covered by the mop-up walk"
             return self._outcome(path, None, 0, info)
@@ -430,21 +650,29 @@ class _Planner:
             data = g.edges[u, v]
             if data["kind"] == "fixed":
                 leg = data["path"]
+                joins += int(data["cost"])
             else:
-                s, _ = data["block"]
-                cost, leg = self.results[(s, data["block"][1], u[2], v[2])]
-                self.stripes[s].cost += cost
+                sweep = data["sweep"]
+                cost, leg = self.results[(sweep.key, sweep.direction, data["block"], u[2], v[2])]
+                sweep.cost += cost
             if leg and leg[0] == path[-1]:
                 leg = leg[1:]
             path += leg
         info["dag_path"] = [list(n) if isinstance(n, tuple) else n for n in dag_path]
-        return self._outcome(path, int(dag_cost), transit, info)
+        info["dag_joins"] = joins  # commands of the DAG's fixed edges: start leg, cut-edges, transits, goal leg
+        return self._outcome(path, int(dag_cost), 0, info)
 
     def _outcome(self, path, dag_cost, transit, info) -> StripeOutcome:
-        details = [{"rows": list(st.own), "band": list(st.band),
-                    "borrowed": (st.band[1] - st.band[0]) - (st.own[1] - st.own[0]),
-                    "cost": st.cost, "regions": len(st.blocks), "direction": st.direction,
-                    "cuts": [b[0] if st.direction > 0 else b[1] for b in st.blocks[1:]]} for st in self.stripes]
+        details = []
+        for k, (own, band) in enumerate(self.bands):
+            mine = [sw for sw in self.sweeps if sw.stripe == k]
+            details.append({
+                "rows": list(own), "band": list(band), "borrowed": (band[1] - band[0]) - (own[1] - own[0]),
+                "cost": sum(sw.cost for sw in mine), "pieces": len(mine), "regions": sum(len(sw.blocks) for sw in mine),
+                "direction": mine[0].direction if mine else 1,
+                "cuts": sorted({b[0] if sw.direction > 0 else b[1] for sw in mine for b in sw.blocks[1:]})})
+        info["order"] = [[sw.stripe, sw.direction] for sw in self.sweeps]
+        info["widening"] = self.widening
         return StripeOutcome(path, dag_cost, transit, details, self.stats["regions"], self.stats["optimal"],
                              self.stats["memo_hits"], self.stats["nodes"], self.time_limited, info)
 
@@ -452,6 +680,28 @@ class _Planner:
 def plan_stripes(lg: LayerGraph, cov: Coverability, start: int, goal: int | None, widths, *, region_columns: int,
                  budget: int, deadline: float | None, memo: bool = True, paper: bool = False) -> StripeOutcome:
     """The stripes' vertex path from ``start`` (to ``goal``, or a free end) along the auxiliary DAG's
-    shortest path; the mop-up and the return to the goal are the caller's."""
-    return _Planner(lg, cov, start, goal, widths, region_columns=region_columns, budget=budget, deadline=deadline,
-                    memo=memo, paper=paper).plan()
+    shortest path; the mop-up and the return to the goal are the caller's.
+
+    Widening is cost-aware in the default variant: when a stripe split into pieces could also be
+    joined by borrowing rows, the plan is made both ways (every split stripe swept piece by piece,
+    and every such stripe widened as the paper does) and the one costing fewer commands with its
+    mop-up wins (ties: the split one)."""
+    options = dict(region_columns=region_columns, budget=budget, deadline=deadline, memo=memo, paper=paper)
+    planner = _Planner(lg, cov, start, goal, widths, **options, widening="joined" if paper else "split")
+    outcome = planner.plan()
+    if paper or not planner.choices:
+        return outcome
+    other = _Planner(lg, cov, start, goal, widths, **options, widening="joined").plan()
+
+    def total(o: StripeOutcome) -> float:
+        if o.dag_cost is None:
+            return math.inf
+        return o.dag_cost + len(lg.commands_of([o.path[-1]] + mop_up(lg, o.path, cov.coverable, cov.reachable)))
+
+    costs = {"split": total(outcome), "joined": total(other)}
+    best = other if costs["joined"] < costs["split"] else outcome
+    best.info["widening_costs"] = costs
+    for name in ("regions", "regions_optimal", "memo_hits", "nodes"):  # both plans' searches count
+        setattr(best, name, getattr(outcome, name) + getattr(other, name))
+    best.time_limited = outcome.time_limited or other.time_limited
+    return best

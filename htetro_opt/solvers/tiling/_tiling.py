@@ -55,6 +55,28 @@ Pre-checks
     pattern order, so a seed gives one tiling, reproducibly, and other seeds others. It takes a few
     seconds on 64 × 64 grids and proves untileability where the backtracker would search for long.
 
+``"auto"`` (the default), a portfolio of fixed, machine-independent budgets (a choice of ours)
+    Each tiler has its tails (benchmarks/README.md, "Tiling without tails"): the backtracker can
+    search for minutes on a 10 × 10 map or a 64 × 64 one with scattered obstacles, which CP-SAT
+    tiles in a fraction of a second and a few seconds; CP-SAT needs minutes on 128 × 128 and larger
+    maps that the backtracker tiles in a second. So ``auto`` runs, in turn:
+
+    1. the backtracker for :data:`AUTO_STEPS` search steps (a few thousand plus 4 a tile): the
+       paper's maps, free grids and ``tiling_64x64`` need fewer, so they keep its tiling;
+    2. on a map taller and wider than two bands, CP-SAT band after band: the uncovered cells of
+       :data:`BAND_ROWS` rows from the top are covered exactly (and at most once the 3 rows below,
+       which tiles of the band reach), the tiles whose first cell lies in the band's top
+       :data:`BAND_COMMIT` rows are kept, and the next band starts below them. Each band has
+       :data:`BAND_WORK` of CP-SAT's deterministic time. The bands run along the map's short side,
+       and when a band fails, once more from the opposite side. A first band that cannot be
+       covered proves that the map cannot be tiled (any tiling holds a cover of it); a later one
+       proves nothing (the bands above might have been tiled otherwise), and the next stage runs;
+    3. CP-SAT on the whole map, until it finds a tiling, proves there is none, or the time limit
+       runs out: then the error says that neither was found.
+
+    Every budget is counted in steps or CP-SAT's deterministic time, not seconds, so a map gets the
+    same tiling on every machine; only ``time_limit`` depends on the clock.
+
 Overlapping sub-workspaces (§3.1, Fig. 5d–f)
     "If the size of the coverage area is not a multiple of hTetro blocks, we can segment this
     workspace into two partially overlapping sub-workspaces and both can be tiled." The paper gives
@@ -100,6 +122,10 @@ from htetro_opt.problems.waypoint_sequencing import (
 from htetro_opt.scenarios.tileset import Tileset
 
 __all__ = [
+    "AUTO_STEPS",
+    "BAND_COMMIT",
+    "BAND_ROWS",
+    "BAND_WORK",
     "EXACT_LIMIT",
     "FLOOD_LIMIT",
     "MEMO_LIMIT",
@@ -109,8 +135,9 @@ __all__ = [
     "tile_workspace",
 ]
 
-TILING_METHODS = ("backtracking", "cpsat")
-"""The tiling methods: the paper's backtracking search and OR-Tools CP-SAT."""
+TILING_METHODS = ("auto", "backtracking", "cpsat")
+"""The tiling methods: a portfolio of the others (the default), the paper's backtracking search and
+OR-Tools CP-SAT."""
 
 FLOOD_LIMIT = 4096
 """Most cells the backtracker's pruning flood fill visits before it treats a region as open."""
@@ -128,6 +155,10 @@ _CHECK_EVERY = 2048  # search steps between two looks at the clock
 
 class _TimeLimit(TilingError):
     """The time limit ran out (the map may still be tileable): never a reason to try a split."""
+
+
+class _OutOfWork(Exception):
+    """A stage of the ``auto`` portfolio used up its work budget: the next stage takes over."""
 
 
 # ------------------------------------------------------------------------------------------------
@@ -353,9 +384,10 @@ def _precheck(occ: np.ndarray, patterns) -> None:
 # Backtracking
 
 
-def _backtrack(occ: np.ndarray, patterns, order, deadline, cache: dict):
+def _backtrack(occ: np.ndarray, patterns, order, deadline, cache: dict, work: list | None = None):
     """Generate the tilings of the free cells as lists of (anchor index, position in ``order``),
-    depth first. ``cache`` maps enclosed regions (normalised) to whether they tile; share it."""
+    depth first. ``cache`` maps enclosed regions (normalised) to whether they tile; share it.
+    ``work``: None, or ``[steps left]``, shared with the region sub-searches; _OutOfWork when spent."""
     h, w = occ.shape
     stride = w + 2 * _PAD
     rows = h + 2 * _PAD
@@ -435,7 +467,7 @@ def _backtrack(occ: np.ndarray, patterns, order, deadline, cache: dict):
             ys, xs = np.nonzero(~small)
             known = _in_lattice(lattice, _class_counts(xs, ys))
             if known:
-                search = _backtrack(np.ascontiguousarray(small), patterns, order, deadline, cache)
+                search = _backtrack(np.ascontiguousarray(small), patterns, order, deadline, cache, work)
                 try:
                     known = next(search, None) is not None
                 finally:
@@ -467,6 +499,10 @@ def _backtrack(occ: np.ndarray, patterns, order, deadline, cache: dict):
         if deadline is not None and steps % _CHECK_EVERY == 0 and _time.perf_counter() > deadline:
             raise _TimeLimit("time limit")
         steps += 1
+        if work is not None:
+            work[0] -= 1
+            if work[0] < 0:
+                raise _OutOfWork
         placed = False
         while k < n_pat:
             o1, o2, o3 = offsets[k]
@@ -506,11 +542,11 @@ def _backtrack(occ: np.ndarray, patterns, order, deadline, cache: dict):
         k += 1
 
 
-def _backtracking_tilings(occ, patterns, seed, deadline):
+def _backtracking_tilings(occ, patterns, seed, deadline, work=None):
     h, w = occ.shape
     stride = w + 2 * _PAD
     order = _pattern_order(len(patterns), seed)
-    for solution in _backtrack(occ, patterns, order, deadline, {}):
+    for solution in _backtrack(occ, patterns, order, deadline, {}, work):
         tiles = []
         for anchor, k in solution:
             r, c = divmod(anchor, stride)
@@ -532,10 +568,21 @@ def _pattern_order(n: int, seed) -> list[int]:
 
 def _cpsat_tilings(occ, patterns, seed, deadline, limit):
     """Up to ``limit`` tilings by CP-SAT; [] when infeasible; _TimeLimit when out of time with none."""
+    return _cpsat_covers(~occ, np.zeros_like(occ), patterns, seed, deadline, limit)
+
+
+def _cpsat_covers(must, may, patterns, seed, deadline, limit, work=None):
+    """Up to ``limit`` sets of tiles covering each ``must`` cell exactly once and each ``may`` cell at
+    most once (every tile touching a ``must`` cell), by CP-SAT; [] when there is none.
+
+    Raises _TimeLimit when the deadline comes first, _OutOfWork when ``work`` (CP-SAT's
+    deterministic seconds, the same on every machine) runs out first.
+    """
     from ortools.sat.python import cp_model
 
-    free = ~occ
-    which, cells = _placements(free, patterns)
+    which, cells = _placements(must | may, patterns)
+    touching = must[cells[..., 1], cells[..., 0]].any(axis=1)
+    which, cells = which[touching], cells[touching]
     # placements in search order: anchor (cells[:, 0]) in scan order, then the seed's pattern order
     rank = np.empty(len(patterns), dtype=np.int64)
     rank[_pattern_order(len(patterns), seed)] = np.arange(len(patterns))
@@ -543,14 +590,17 @@ def _cpsat_tilings(occ, patterns, seed, deadline, limit):
     cells = cells[by]
     model = cp_model.CpModel()
     xs = [model.NewBoolVar("") for _ in range(len(cells))]
-    h, w = occ.shape
+    h, w = must.shape
     flat = (cells[..., 1] * w + cells[..., 0]).ravel()
     owner = np.repeat(np.arange(len(cells)), 4)
     by_cell = np.argsort(flat, kind="stable")
-    bounds = np.searchsorted(flat[by_cell], np.arange(h * w + 1))
+    bounds = np.searchsorted(flat[by_cell], np.arange(h * w + 1)).tolist()
     owner = owner[by_cell].tolist()
-    for c in np.flatnonzero(free.ravel()).tolist():
+    for c in np.flatnonzero(must.ravel()).tolist():
         model.AddExactlyOne([xs[i] for i in owner[bounds[c]:bounds[c + 1]]])
+    for c in np.flatnonzero(may.ravel()).tolist():
+        if bounds[c + 1] - bounds[c] > 1:
+            model.AddAtMostOne([xs[i] for i in owner[bounds[c]:bounds[c + 1]]])
     # The backtracker's order, declared as a search strategy: CP-SAT's portfolio (one worker) takes
     # turns between it and its own heuristics at each restart, with propagation and clause learning.
     model.AddDecisionStrategy(xs, cp_model.CHOOSE_FIRST, cp_model.SELECT_MAX_VALUE)
@@ -562,12 +612,15 @@ def _cpsat_tilings(occ, patterns, seed, deadline, limit):
     params.random_seed = 0 if seed is None else int(seed)
     params.search_branching = cp_model.PORTFOLIO_SEARCH
     # measured on 24 x 24 to 64 x 64 grids: presolve, probing and inprocessing cost seconds and
-    # find nothing on an exact cover; the fixed search alone stalls on some maps (h_shape)
+    # find nothing on an exact cover; the fixed search alone stalls on some maps (h_shape), and
+    # CP-SAT's default parameters time out on 64 x 64 maps it solves in seconds like this
     params.cp_model_presolve = False
     params.cp_model_probing_level = 0
     params.linearization_level = 0
     params.symmetry_level = 0
     params.use_sat_inprocessing = False
+    if work is not None:
+        params.max_deterministic_time = work
     if deadline is not None:
         left = deadline - _time.perf_counter()
         if left <= 0:
@@ -600,8 +653,96 @@ def _cpsat_tilings(occ, patterns, seed, deadline, limit):
     if status == cp_model.INFEASIBLE:
         return []
     if status == cp_model.UNKNOWN:
-        raise _TimeLimit("time limit")
+        if deadline is not None and _time.perf_counter() >= deadline - 1e-3:
+            raise _TimeLimit("time limit")
+        if work is not None:
+            raise _OutOfWork
+        raise _TimeLimit("time limit")  # stopped by a signal handler that did not raise
     raise TilingError(f"CP-SAT ended with status {solver.StatusName(status)} on the tiling model")
+
+
+# ------------------------------------------------------------------------------------------------
+# The auto portfolio
+
+
+AUTO_STEPS = (5_000, 4)
+"""The backtracking stage of ``auto``: ``a + b × tiles`` search steps (deterministic), then the next
+stage. The paper's maps, free grids up to 256 × 256 and ``tiling_64x64`` take under one step per tile
+beyond a few hundred, so they keep the backtracker's tiling."""
+
+BAND_ROWS = 12
+"""Rows of the cells a band of the ``auto`` portfolio's band stage covers exactly (3 more rows below
+it may be covered, by tiles that stick out of it)."""
+
+BAND_COMMIT = 6
+"""Rows from the top of a band whose tiles (by their first cell) are kept before the next band."""
+
+BAND_WORK = 2.0
+"""CP-SAT's deterministic time (its own unit, about a second, the same on every machine) for one band."""
+
+
+def _band_tiling(occ, patterns, seed, deadline, turns):
+    """One tiling by CP-SAT, band after band of :data:`BAND_ROWS` rows from the top; [] when the
+    first band has no cover (a proof: any tiling restricted to the tiles touching it is one);
+    _OutOfWork when a later band has none or CP-SAT spends :data:`BAND_WORK` on one (no proof:
+    the bands above could have been tiled otherwise)."""
+    grid = np.rot90(occ, turns)  # a quarter turn maps each tetromino onto one of its own shape
+    h = grid.shape[0]
+    covered = grid.copy()
+    tiles: list[np.ndarray] = []
+    top = 0  # the rows y >= h - top are covered
+    while True:
+        lo, hi = max(0, h - top - BAND_ROWS), h - top
+        must = np.zeros_like(grid)
+        must[lo:hi] = ~covered[lo:hi]
+        may = np.zeros_like(grid)
+        may[max(0, lo - _PAD):lo] = ~covered[max(0, lo - _PAD):lo]
+        found = _cpsat_covers(must, may, patterns, seed, deadline, 1, work=BAND_WORK)
+        if not found:
+            if top == 0:
+                return []
+            raise _OutOfWork
+        band = found[0]
+        if lo == 0:
+            tiles += band
+            break
+        cut = h - top - BAND_COMMIT  # keep the tiles whose first cell lies in the band's top rows
+        for tile in band:
+            if tile[:, 1].max() >= cut:
+                tiles.append(tile)
+                covered[tile[:, 1], tile[:, 0]] = True
+        top += BAND_COMMIT
+    back = np.zeros(grid.shape, dtype=np.int64)  # cell (x', y') of grid → flat index (y, x) of occ
+    back[:] = np.rot90(np.arange(occ.size).reshape(occ.shape), turns)
+    w = occ.shape[1]
+    return [[np.stack([back[t[:, 1], t[:, 0]] % w, back[t[:, 1], t[:, 0]] // w], axis=1) for t in tiles]]
+
+
+def _auto_tilings(occ, patterns, seed, deadline, limit):
+    """The ``auto`` portfolio: backtracking for :data:`AUTO_STEPS`, then (one tiling of a map
+    taller and wider than two bands) the band stage, then CP-SAT on the whole map."""
+    tiles = int((~occ).sum()) // 4
+    found = []
+    generator = _backtracking_tilings(occ, patterns, seed, deadline, [AUTO_STEPS[0] + AUTO_STEPS[1] * tiles])
+    try:
+        for tiling in generator:
+            found.append(tiling)
+            if len(found) >= limit:
+                return found
+        return found
+    except _OutOfWork:
+        pass
+    finally:
+        generator.close()
+    if limit == 1 and min(occ.shape) > 2 * BAND_ROWS:
+        # bands along the short side, from one end, then from the other (where the first try ended)
+        first = 1 if occ.shape[1] > occ.shape[0] else 0
+        for turns in (first, first + 2):
+            try:
+                return _band_tiling(occ, patterns, seed, deadline, turns)
+            except _OutOfWork:
+                pass
+    return _cpsat_tilings(occ, patterns, seed, deadline, limit)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -611,7 +752,10 @@ def _cpsat_tilings(occ, patterns, seed, deadline, limit):
 def _time_message(method, time_limit) -> str:
     if method == "backtracking":
         return (f"the backtracking search found no tiling within the time limit of {time_limit:g} s; "
-                "try the cpsat method or a longer time limit")
+                "try the auto or cpsat method or a longer time limit")
+    if method == "auto":
+        return (f"no tiling found and none proven impossible within the time limit of {time_limit:g} s "
+                "(backtracking, bands, then CP-SAT); try a longer time limit")
     return f"CP-SAT found no tiling within the time limit of {time_limit:g} s; try a longer time limit"
 
 
@@ -631,6 +775,8 @@ def _tilings(occ, patterns, method, seed, deadline, limit):
                 raise
         finally:
             generator.close()
+    elif method == "auto":
+        found = _auto_tilings(occ, patterns, seed, deadline, limit)
     else:
         found = _cpsat_tilings(occ, patterns, seed, deadline, limit)
     if not found:
@@ -646,7 +792,7 @@ def _retime(method, time_limit) -> TilingError:
     return TilingError(_time_message(method, time_limit))
 
 
-def find_tiles(occupancy, *, shapes=None, method: str = "backtracking", shuffle: bool = False, seed=None,
+def find_tiles(occupancy, *, shapes=None, method: str = "auto", shuffle: bool = False, seed=None,
                time_limit: float | None = None) -> list[np.ndarray]:
     """An exact cover of the free cells by tetrominoes of the allowed shapes.
 
@@ -656,8 +802,9 @@ def find_tiles(occupancy, *, shapes=None, method: str = "backtracking", shuffle:
         ``occ[y, x]``, True for an obstacle.
     shapes : iterable of str, optional
         The allowed morphologies, e.g. ``"TZ"`` or ``["O"]``; all seven when None.
-    method : {"backtracking", "cpsat"}
-        The paper's backtracking search or CP-SAT (see the module docstring).
+    method : {"auto", "backtracking", "cpsat"}
+        The portfolio (default), the paper's backtracking search or CP-SAT (see the module
+        docstring). ``auto`` gives the backtracker's tiling wherever the backtracker needs few steps.
     shuffle : bool
         False (default): the fixed pattern order, one tiling per map, ``seed`` unused. True: the
         pattern order (and CP-SAT's random seed) drawn from ``seed``, for another tiling.
@@ -676,7 +823,8 @@ def find_tiles(occupancy, *, shapes=None, method: str = "backtracking", shuffle:
     TilingError
         If a pre-check fails (no free cell; free area, or a 4-connected region's area, not a multiple
         of 4; unequal checkerboard colours without T; a cell no allowed tile fits over), if no tiling
-        exists, or if the time limit runs out first.
+        exists, or if the time limit runs out first (the message then says that neither a tiling
+        nor a proof that none exists was found).
     UnknownShapeError
         If a shape name is unknown.
     ParameterError
@@ -751,7 +899,7 @@ def _overlapping_tiles(occ, patterns, method, seed, deadline, cause):
     ) from cause
 
 
-def tile_workspace(workspace, *, shapes=None, method: str = "backtracking", shuffle: bool = False, seed=None,
+def tile_workspace(workspace, *, shapes=None, method: str = "auto", shuffle: bool = False, seed=None,
                    time_limit: float | None = None, overlap: bool = False, weights=DEFAULT_BLOCK_WEIGHTS,
                    name: str = "") -> Tileset:
     """Tile a workspace and label the tiles by Algorithm 1: the waypoints of Le et al. 2018.
@@ -812,7 +960,7 @@ def tile_workspace(workspace, *, shapes=None, method: str = "backtracking", shuf
     return block_locations(occ, tiles, weights=weights, cell_size=cell_size, name=name)
 
 
-def enumerate_tilings(workspace, *, shapes=None, limit: int = 10, method: str = "backtracking",
+def enumerate_tilings(workspace, *, shapes=None, limit: int = 10, method: str = "auto",
                       time_limit: float | None = None, weights=DEFAULT_BLOCK_WEIGHTS) -> list[Tileset]:
     """Up to ``limit`` distinct tilings of a workspace (distinct as sets of tiles), labelled.
 

@@ -89,6 +89,21 @@ def test_plan_ga_reports_convergence_per_leg():
     assert leg.converged is True and leg.generations < 300  # stopped by patience, not by the cap
 
 
+def test_hypervolume_convergence_ends_legs_sooner_with_the_same_best_time():
+    # patience 20 by default with the hypervolume measure, 100 with the best-fitness one
+    runs = {measure: plan_ga(OPEN, [START, GOAL], pop_size=16, max_gen=400, max_length=20, seed=3,
+                             convergence=measure) for measure in ("best", "hypervolume")}
+    best, volume = runs["best"].legs[0], runs["hypervolume"].legs[0]
+    assert volume.converged and best.converged
+    assert volume.generations < best.generations
+    assert volume.selected["time"].time == best.selected["time"].time == 7.0  # the exact optimum
+    again = plan_ga(OPEN, [START, GOAL], pop_size=16, max_gen=400, max_length=20, seed=3, convergence="hypervolume",
+                    patience=volume.generations)  # a patience of its own overrides the measure's default
+    assert again.legs[0].generations > volume.generations
+    with pytest.raises(ParameterError, match="convergence"):
+        plan_ga(OPEN, [START, GOAL], convergence="volume")
+
+
 def test_plan_ga_errors():
     roadmap = [START, GOAL]
     with pytest.raises(ParameterError):
@@ -181,6 +196,14 @@ def test_cli_ga_flags(capsys):
     code, out, err = cli(capsys, ["plan", "three_slit", "--method", "htetro-ga", "--pop-size", "10", "--max-gen", "3",
                                   "--seed-exact", "--quiet"])
     assert code == 0 and "gap to the exact optimum (33 s): balanced" in out
+    runs = {}
+    for measure in ("best", "hypervolume"):
+        code, out, err = cli(capsys, ["plan", "random", "--method", "htetro-ga", "--pop-size", "16", "--max-gen",
+                                      "300", "--patience", "4", "--converge", measure, "--json", "--quiet"])
+        assert code == 0, err
+        runs[measure] = json.loads(out)["legs"][0]
+    assert runs["hypervolume"]["converged"] and runs["best"]["converged"]
+    assert runs["hypervolume"]["generations"] != runs["best"]["generations"]  # the flag reaches the termination
 
 
 @pytest.mark.parametrize("argv, flag", [
@@ -192,6 +215,8 @@ def test_cli_ga_flags(capsys):
     (["--method", "dijkstra", "--seed-exact"], "--seed-exact"),
     (["--method", "astar", "--pick", "fastest"], "--pick"),
     (["--method", "heat", "--replan-window", "5"], "--replan-window"),
+    (["--method", "htetro-ga", "--converge", "volume"], "--converge"),
+    (["--method", "dijkstra", "--converge", "hypervolume"], "--converge"),
 ])
 def test_cli_bad_ga_flags_exit_2(capsys, argv, flag):
     code, out, err = cli(capsys, ["plan", "three_slit", *argv, "--quiet"])

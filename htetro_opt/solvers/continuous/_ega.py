@@ -1,0 +1,265 @@
+"""Nazarahari et al. 2019's enhanced GA as a planning method: APF initial paths, the EGA (or pymoo's
+multi-objective algorithms) over path bases, one :class:`ContinuousPlan`.
+
+One ``seed`` drives a whole run (None: fresh entropy; an int or a numpy Generator: reproducible): it
+breaks the APF's ties and seeds pymoo, whose ``random_state`` every operator draws from.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import numpy as np
+
+from htetro_opt._validation import as_rng, check_bool, check_int, derive_seed
+from htetro_opt.errors import ParameterError
+from htetro_opt.problems.path_bases import DEFAULT_PATH_WEIGHTS, TINY_SAFETY, PathBasesProblem, check_path_weights
+from htetro_opt.solvers.continuous._astar import check_grid
+from htetro_opt.solvers.continuous._result import ContinuousPlan, check_scenario, finish_plan
+
+__all__ = ["plan_ega", "plan_ega_paper", "plan_moea", "plan_nsga2", "MOEA_ALGORITHMS"]
+
+MOEA_ALGORITHMS = ("nsga2", "nsga3", "smsemoa", "agemoea")
+"""pymoo's algorithms :func:`plan_moea` runs over path bases."""
+
+
+def _initial(scenario, *, grid: float, pop_size: int, finer: bool, rng) -> list:
+    """Each robot's APF paths (an empty list for a robot whose goal is unreachable)."""
+    from htetro_opt.operators.path_bases.sampling import initial_paths
+
+    return [initial_paths(scenario.geometry, s, g, pop_size, grid=grid, finer=finer, seed=rng)
+            for s, g in zip(scenario.starts, scenario.goals)]
+
+
+def _reachable(scenario, initial: list):
+    """The scenario of the robots whose goals the APF reaches, and their indices."""
+    rows = [i for i, paths in enumerate(initial) if paths]
+    if len(rows) == scenario.n_robots:
+        return scenario, rows
+    return dataclasses.replace(scenario, starts=scenario.starts[rows], goals=scenario.goals[rows]), rows
+
+
+def _as_path(line: np.ndarray) -> np.ndarray:
+    return line[:1].copy() if (line == line[0]).all() else line
+
+
+def _best(problem: PathBasesProblem, xs: list):
+    """The member to report: obstacle-free paths first, then fewest conflicts, then the cost."""
+    terms = problem.measure(xs)
+    F, _ = problem.objectives_of(terms)
+    order = np.lexsort((F[:, 0], terms["conflicts"], terms["bad"].sum(axis=1)))
+    return xs[int(order[0])]
+
+
+def _run_ga(scenario, *, variant: str, path: str, weights, safety: str, grid: float, pop_size: int,
+            max_gen: int, rng) -> tuple[list, list, dict]:
+    """One EGA run: (per-robot polylines or None, per-robot PBs or None, info)."""
+    from pymoo.optimize import minimize
+
+    from htetro_opt.algorithms.enhanced_ga import EnhancedGA
+    from htetro_opt.operators.path_bases import PathBasesSampling
+
+    finer = variant == "ega"
+    initial = _initial(scenario, grid=grid, pop_size=pop_size, finer=finer, rng=rng)
+    sub, rows = _reachable(scenario, initial)
+    lines, pbs = [None] * scenario.n_robots, [None] * scenario.n_robots
+    info = {"algorithm": variant, "weights": list(weights), "path": path, "safety": safety, "grid": grid,
+            "pop_size": pop_size, "max_gen": max_gen}
+    if not rows:
+        return lines, pbs, {**info, "history": [], "terms": None}
+    problem = PathBasesProblem(sub, path=path, weights=weights, safety=safety, grid=grid)
+    sampling = PathBasesSampling([initial[i] for i in rows])
+    algorithm = (EnhancedGA if variant == "ega" else EnhancedGA.as_published)(pop_size, sampling=sampling)
+    res = minimize(problem, algorithm, ("n_gen", max_gen + 1), seed=derive_seed(rng))
+    best = _best(problem, [ind.X[0] for ind in res.algorithm.pop])
+    for k, row in enumerate(rows):
+        part = problem.robots(best)[k]
+        lines[row] = _as_path(problem.polyline(part, k))
+        pbs[row] = part
+    return lines, pbs, {**info, "history": list(res.algorithm.history), "terms": problem.measure([best])}
+
+
+def _check_common(scenario, path, safety, grid, pop_size, max_gen):
+    scenario = check_scenario(scenario)
+    grid = check_grid(grid, scenario.geometry)
+    pop_size = check_int(pop_size, "pop_size", minimum=2)
+    max_gen = check_int(max_gen, "max_gen", minimum=0)
+    PathBasesProblem(scenario, path=path, safety=safety, grid=grid)  # validates path and safety
+    return scenario, grid, pop_size, max_gen
+
+
+def _plan_weighted(scenario, *, variant, path, weights, normalise, safety, grid, pop_size, max_gen, seed):
+    began = time.perf_counter()
+    scenario, grid, pop_size, max_gen = _check_common(scenario, path, safety, grid, pop_size, max_gen)
+    normalise = check_bool(normalise, "normalise")
+    if normalise and weights is not None:
+        raise ParameterError("give weights or normalise=True, not both")
+    weights = check_path_weights(DEFAULT_PATH_WEIGHTS if weights is None else weights)
+    rng = as_rng(seed)
+    extra = {}
+    if normalise:
+        # §5.3: one run per term, then W_S = L*/S*, W_R = L*/c_R* (c_R = 1 / safety)
+        optima = []
+        for term, name in enumerate(("length", "smoothness", "safety")):
+            single = tuple(float(term == k) for k in range(3))
+            terms = _run_ga(scenario, variant=variant, path=path, weights=single, safety=safety, grid=grid,
+                            pop_size=pop_size, max_gen=max_gen, rng=rng)[2]["terms"]
+            if terms is None:
+                optima.append(float("nan"))
+            elif term < 2:
+                optima.append(float(terms[name].sum()))
+            else:
+                optima.append(float((1.0 / np.maximum(terms["safety"], TINY_SAFETY)).sum()))
+        best_length, best_smoothness, best_safety_cost = optima
+        weights = (1.0, best_length / best_smoothness if best_smoothness > 0 else 0.0,
+                   best_length / best_safety_cost if np.isfinite(best_safety_cost) and best_safety_cost > 0 else 0.0)
+        extra["normalised_from"] = {"length": best_length, "smoothness_deg": best_smoothness,
+                                    "safety_cost": best_safety_cost}
+    lines, pbs, info = _run_ga(scenario, variant=variant, path=path, weights=weights, safety=safety, grid=grid,
+                               pop_size=pop_size, max_gen=max_gen, rng=rng)
+    history = info.pop("history")
+    info.pop("terms")
+    info.update(extra, path_bases=[None if p is None else p.tolist() for p in pbs])
+    # a spline through the PBs may cut a corner in every member: reported as infeasible, not raised
+    return finish_plan(scenario, lines, method=variant, began=began, history=history, info=info,
+                       require_feasible=path == "linear")
+
+
+def plan_ega(scenario, *, path: str = "linear", weights=None, normalise: bool = False, safety: str = "paper",
+             grid: float = 1.0, pop_size: int = 10, max_gen: int = 20, seed=None) -> ContinuousPlan:
+    """Every robot's path by Nazarahari et al. 2019's enhanced GA with our additions (deletion of
+    every child, taut refinement, a finer APF for half the initial paths; see
+    :class:`~htetro_opt.algorithms.EnhancedGA`), several robots planned jointly (§4.5).
+
+    Parameters
+    ----------
+    scenario : ContinuousScenario
+    path : {"linear", "spline"}, keyword-only
+    weights : three floats, keyword-only
+        (W_L, W_S, W_R) of eq. 6; default (1, 0, 0).
+    normalise : bool, keyword-only
+        §5.3: three single-term runs give L*, S* and c_R* (c_R = 1 / safety), then a run with
+        W = (1, L*/S*, L*/c_R*) (a zero S* gives W_S = 0). Not with ``weights``.
+    safety : {"paper", "min"}, keyword-only
+        Eq. 5's R over the PBs, or the smallest clearance along the path.
+    grid : float, keyword-only
+        d, the APF's lattice and the mutations' step (1).
+    pop_size, max_gen : int, keyword-only
+        PS and IS (10 and 20, as in Table 2).
+    seed : None, int or numpy Generator, keyword-only
+
+    Returns
+    -------
+    ContinuousPlan
+        ``history``: the best cost per generation (the initial population first); ``info``:
+        ``algorithm, weights, path, safety, grid, pop_size, max_gen, path_bases`` (per robot), and
+        ``normalised_from`` with ``normalise``. A robot whose goal the APF cannot reach (even at
+        d/8) is not reached. With ``path="spline"`` a path may come out infeasible (every member's
+        spline cutting a corner): ``feasible`` says so.
+
+    Raises
+    ------
+    ParameterError
+        On a bad option (see :class:`~htetro_opt.problems.PathBasesProblem`), or both ``weights`` and
+        ``normalise``.
+
+    Examples
+    --------
+    >>> from htetro_opt.scenarios import load_scenario
+    >>> plan = plan_ega(load_scenario("ega07_slits1"), seed=1)
+    >>> plan.reached, round(plan.length, 2)  # the exact optimum is 64.43
+    (True, 64.43)
+    """
+    return _plan_weighted(scenario, variant="ega", path=path, weights=weights, normalise=normalise, safety=safety,
+                          grid=grid, pop_size=pop_size, max_gen=max_gen, seed=seed)
+
+
+def plan_ega_paper(scenario, *, path: str = "linear", weights=None, normalise: bool = False, safety: str = "paper",
+                   grid: float = 1.0, pop_size: int = 10, max_gen: int = 20, seed=None) -> ContinuousPlan:
+    """:func:`plan_ega` with the EGA as published (:meth:`~htetro_opt.algorithms.EnhancedGA.as_published`):
+    deletion of one roulette pick per generation, no taut refinement, the APF at step d only."""
+    return _plan_weighted(scenario, variant="ega-paper", path=path, weights=weights, normalise=normalise,
+                          safety=safety, grid=grid, pop_size=pop_size, max_gen=max_gen, seed=seed)
+
+
+def plan_moea(scenario, *, algorithm: str = "nsga2", path: str = "linear", safety: str = "min", grid: float = 1.0,
+              pop_size: int = 10, max_gen: int = 20, seed=None) -> ContinuousPlan:
+    """A front of paths minimising (L, S, −safety) by one of pymoo's multi-objective algorithms over
+    path bases (:func:`~htetro_opt.algorithms.make_path_algorithm`: APF initial paths, the EGA's
+    crossovers and mutations, deletion as the repair, where no objective may rise).
+
+    Returns
+    -------
+    ContinuousPlan
+        The paths of the front's shortest member; ``info["front"]``: every non-dominated feasible
+        member (sorted by length), ``{"objectives": {"length", "smoothness_deg", "safety"}, "paths"}``.
+        A robot whose goal the APF cannot reach is not reached.
+
+    Raises
+    ------
+    ParameterError
+        On an unknown algorithm or a bad option.
+
+    Examples
+    --------
+    >>> from htetro_opt.scenarios import load_scenario
+    >>> plan = plan_moea(load_scenario("ega04_corridor1"), seed=0)
+    >>> plan.reached, len(plan.info["front"]) >= 1
+    (True, True)
+    """
+    from pymoo.optimize import minimize
+
+    from htetro_opt.algorithms.enhanced_ga import make_path_algorithm
+    from htetro_opt.operators.path_bases import PathBasesSampling
+
+    began = time.perf_counter()
+    if algorithm not in MOEA_ALGORITHMS:
+        raise ParameterError(f"unknown algorithm {algorithm!r}: expected one of {', '.join(MOEA_ALGORITHMS)}")
+    scenario, grid, pop_size, max_gen = _check_common(scenario, path, safety, grid, pop_size, max_gen)
+    rng = as_rng(seed)
+    initial = _initial(scenario, grid=grid, pop_size=pop_size, finer=False, rng=rng)
+    sub, rows = _reachable(scenario, initial)
+    lines = [None] * scenario.n_robots
+    info = {"algorithm": algorithm, "path": path, "safety": safety, "grid": grid, "pop_size": pop_size,
+            "max_gen": max_gen, "front": []}
+    history = []
+    if rows:
+        problem = PathBasesProblem(sub, path=path, safety=safety, objectives="separate", grid=grid)
+        moea = make_path_algorithm(algorithm, pop_size, sampling=PathBasesSampling([initial[i] for i in rows]))
+        res = minimize(problem, moea, ("n_gen", max_gen + 1), seed=derive_seed(rng),
+                       callback=lambda alg: history.append(float(np.min(alg.pop.get("F")[:, 0]))))
+        front = _front(problem, res.algorithm.pop)
+        best = front[0][1] if front else _best(problem, [ind.X[0] for ind in res.algorithm.pop])
+        for k, row in enumerate(rows):
+            lines[row] = _as_path(problem.polyline(problem.robots(best)[k], k))
+        for F, x in front:
+            paths = [None] * scenario.n_robots
+            for k, row in enumerate(rows):
+                paths[row] = _as_path(problem.polyline(problem.robots(x)[k], k)).tolist()
+            info["front"].append({"objectives": {"length": float(F[0]), "smoothness_deg": float(F[1]),
+                                                 "safety": float(-F[2])}, "paths": paths})
+    return finish_plan(scenario, lines, method=algorithm, began=began, history=history, info=info,
+                       require_feasible=path == "linear")
+
+
+def _front(problem: PathBasesProblem, pop) -> list:
+    """The feasible non-dominated members, distinct in F, sorted by length."""
+    from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
+
+    F, G = pop.get("F", "G")
+    feasible = np.flatnonzero(G[:, 0] <= 0)
+    if not len(feasible):
+        return []
+    first = feasible[NonDominatedSorting().do(F[feasible], only_non_dominated_front=True)]
+    _, unique = np.unique(F[first].round(12), axis=0, return_index=True)
+    first = first[unique]
+    first = first[np.argsort(F[first, 0], kind="stable")]
+    return [(F[i], pop[i].X[0]) for i in first]
+
+
+def plan_nsga2(scenario, *, path: str = "linear", safety: str = "min", grid: float = 1.0, pop_size: int = 10,
+               max_gen: int = 20, seed=None) -> ContinuousPlan:
+    """:func:`plan_moea` with pymoo's NSGA-II."""
+    return plan_moea(scenario, algorithm="nsga2", path=path, safety=safety, grid=grid, pop_size=pop_size,
+                     max_gen=max_gen, seed=seed)

@@ -1,0 +1,130 @@
+"""The hTetro-GA's loop on arrays: the same runs as the Population-based loop it replaced, each
+offspring simulated once, and pymoo's interfaces (minimize, ask and tell, pop and opt) intact."""
+
+from __future__ import annotations
+
+import hashlib
+
+import numpy as np
+import pytest
+from pymoo.optimize import minimize
+
+from htetro_opt.algorithms import HTetroGA, make_algorithm
+from htetro_opt.model import SEED000_COMMANDS, Pose, Simulator, Workspace
+from htetro_opt.operators.commands import sequences
+from htetro_opt.problems import CommandPathProblem
+from htetro_opt.scenarios import load_scenario
+
+
+def scenario_problem(name: str) -> CommandPathProblem:
+    scenario = load_scenario(name)
+    sim = Simulator(scenario.workspace, commands=SEED000_COMMANDS)
+    return CommandPathProblem(sim, scenario.start, scenario.roadmap[1], max_length=100)
+
+
+def digest(X, F) -> str:
+    h = hashlib.sha256()
+    for x in X:
+        h.update(np.asarray(x, dtype=np.int64).tobytes() + b"|")
+    h.update(np.ascontiguousarray(F, dtype=np.float64).tobytes())
+    return h.hexdigest()[:16]
+
+
+# Final populations (chromosomes and F, bit for bit) and evaluation counts of 60 generations at
+# n_pop 40, recorded with the Population-based loop before the array loop replaced it (the same
+# algorithm: these change only when the algorithm does, and then on purpose).
+RECORDED = {
+    ("three_slit", "htetro-ga", 0): ("614c12a8a1e991bb", 3547),
+    ("random", "htetro-ga", 1): ("dd1447ed937d0215", 3706),
+    ("parallel_dynamic", "htetro-ga", 0): ("ad7bf16198896728", 4095),  # moving obstacles
+    ("three_slit", "htetro-ga-paper", 1): ("8f872e1be329292d", 3643),
+}
+
+
+@pytest.mark.parametrize("case", list(RECORDED), ids=["-".join(map(str, c)) for c in RECORDED])
+def test_a_fixed_seed_gives_the_population_the_population_based_loop_gave(case):
+    name, method, seed = case
+    res = minimize(scenario_problem(name), make_algorithm(method, 40), ("n_gen", 60), seed=seed)
+    assert (digest(sequences(res.pop.get("X")), res.pop.get("F")), res.algorithm.evaluator.n_eval) == RECORDED[case]
+
+
+def count_runs(problem):
+    calls = []
+    inner = problem.simulator.run
+
+    def counted(sequences, *args, **kwargs):
+        calls.append(len(sequences))
+        return inner(sequences, *args, **kwargs)
+
+    problem.simulator.run = counted
+    return calls
+
+
+def open_problem(moving=False):
+    occ = np.zeros((12, 12), dtype=bool)
+    occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
+    ws = Workspace(occ)
+    if moving:
+        from htetro_opt.model import MovingObstacle
+
+        ws = Workspace(occ, moving=(MovingObstacle(cells=((9, 2),), route=((0, 0), (0, 1), (0, 2), (0, 1))),))
+    return CommandPathProblem(ws, Pose(3, 3, "O", 0), Pose(7, 6, "O", 0), max_length=20)
+
+
+def test_each_offspring_is_simulated_once():
+    problem = open_problem()
+    algorithm = HTetroGA(pop_size=20, replan_window=0)
+    algorithm.setup(problem, termination=("n_gen", 10), seed=0)
+    algorithm.next()  # the initial population: pymoo's sampling, repair and evaluator
+    calls = count_runs(problem)
+    for _ in range(5):
+        before = len(calls)
+        algorithm.next()
+        assert len(calls) - before == 1  # one simulation repairs, shortcuts and scores them all
+        assert calls[-1] == 2 * algorithm.pop_size  # both offspring sets, before duplicates are dropped
+
+
+def test_with_moving_obstacles_only_the_shortened_paths_are_simulated_again():
+    problem = open_problem(moving=True)
+    algorithm = HTetroGA(pop_size=20, replan_window=0)
+    algorithm.setup(problem, termination=("n_gen", 10), seed=0)
+    algorithm.next()
+    calls = count_runs(problem)
+    algorithm.next()
+    assert calls[0] == 40 and len(calls) <= 2 and sum(calls[1:]) <= 20  # at most the conservative set again
+
+
+def test_ask_and_tell_runs_the_same_generations_as_minimize():
+    problem = open_problem()
+    res = minimize(problem, HTetroGA(pop_size=16), ("n_gen", 12), seed=3)
+    algorithm = HTetroGA(pop_size=16)
+    algorithm.setup(problem, termination=("n_gen", 12), seed=3)
+    while algorithm.has_next():
+        infills = algorithm.ask()
+        if infills is not None:
+            algorithm.evaluator.eval(problem, infills)  # already evaluated: nothing to do
+        algorithm.tell(infills=infills)
+    assert [s.tolist() for s in sequences(algorithm.pop.get("X"))] == [s.tolist() for s in sequences(res.pop.get("X"))]
+    assert np.array_equal(algorithm.pop.get("F"), res.pop.get("F"))
+    assert algorithm.evaluator.n_eval == res.algorithm.evaluator.n_eval
+
+
+def test_the_boundary_population_is_current():
+    problem = open_problem()
+    algorithm = HTetroGA(pop_size=16)
+    algorithm.setup(problem, termination=("n_gen", 8), seed=1)
+    kept = None
+    for _ in range(8):
+        algorithm.next()
+        pop = algorithm.pop
+        X = sequences(pop.get("X"))
+        outcome = problem.evaluate(np.array(pop.get("X")), return_as_dictionary=True)
+        for key in ("F", "reached", "executed", "time", "end"):  # every column is that of the chromosome
+            assert np.array_equal(np.asarray(pop.get(key)).astype(float), np.asarray(outcome[key]).astype(float)), key
+        rank = pop.get("rank")
+        assert np.array_equal(rank, np.sort(rank)) and rank[0] == 0  # survivors in order of the sort
+        assert len(algorithm.opt) == (rank == 0).sum()
+        if kept is not None:  # a survivor keeps its pymoo Individual from one generation to the next
+            assert any(ind is kept for ind in pop)
+        kept = pop[0]
+        assert len({tuple(x.tolist()) for x in X}) == len(X)
