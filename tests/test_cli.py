@@ -314,7 +314,10 @@ def test_simulate_without_start(capsys, tmp_path):
 def test_plan_on_continuous_scenario(capsys, tmp_path):
     path = tmp_path / "cont.toml"
     path.write_text('name = "cont"\nsource = "t"\nwidth = 5\nheight = 5\n[[robots]]\nstart = [1, 1]\ngoal = [4, 4]\n')
-    assert_one_error_line(*run(capsys, ["plan", str(path)]), "continuous")
+    # grid-only methods refuse a continuous scenario; its own methods plan it (tests/solvers/continuous/test_cli.py)
+    assert_one_error_line(*run(capsys, ["plan", str(path), "--method", "dijkstra"]), "continuous")
+    out = run_json(capsys, ["plan", str(path), "--method", "exact", "--json"])
+    assert out["reached"] is True
 
 
 def test_no_command_shows_the_usage_and_the_commands(capsys):

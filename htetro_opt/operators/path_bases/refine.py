@@ -7,6 +7,12 @@ the visibility graph (:func:`~htetro_opt.solvers.continuous.visibility_path`, th
 code with its tangent pruning) of the path's own PBs and of the free space's corners within ``reach``
 (2 d) of the path. The path itself is in that graph, so the result is never longer; it is kept if its
 cost is lower (for a spline or other weights the taut polyline need not be better).
+
+Two prunings keep the graph cheap (each segment costs a feasibility test): two PBs are joined only
+where the path joins them (a shortcut past PBs bends at corners, which are in the graph), and two
+points only when the path between their nearest points on it is at most :data:`DETOUR` times their
+distance plus 4 d (the other segments cross a wall). Measured: half the run time on the mazes and
+the plank pile, the same lengths.
 """
 
 from __future__ import annotations
