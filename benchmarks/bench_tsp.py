@@ -14,7 +14,8 @@
    at random or 150 random blocks of up to 3 × 3, 128 × 128 with furniture (2 × 2 and 4 × 4 blocks one
    cell apart) or 5 % of the cells blocked, and a free 256 × 256. Verdicts must agree.
 5. Backends: the outside solvers ``fast-tsp`` and ``lkh`` (LKH-3 through elkai), where installed,
-   beside the project's ``local`` (plain and iterated) and ``auto``: on two small TSPLIB instances with their
+   beside the project's ``local`` (plain and iterated) and ``ils`` (the compiled iterated local search, its
+   kick budget; auto's engine beyond 40 waypoints): on two small TSPLIB instances with their
    published optima (burma14, ulysses16, data inline), TSPLIB-like random uniform instances (integer
    coordinates in [0, 10⁴), EUC_2D rounding, closed tours; no TSPLIB files are on this machine, so
    LKH with one run is their reference) and the eq.-2 instance of tiling_64x64 (open path from
@@ -32,11 +33,16 @@ import time
 
 import numpy as np
 
+from htetro_opt.errors import TilingError
 from htetro_opt.problems import SequencingInstance, cost_matrix
-from htetro_opt.scenarios import list_tilesets, load_scenario, load_tileset, tileset_path
+from htetro_opt.scenarios import (
+    list_tilesets,
+    load_scenario,
+    load_tileset,
+    tileset_path,
+)
 from htetro_opt.scenarios.tsplib import parse_tsplib, tsplib_distances
 from htetro_opt.solvers.sequencing import sequence_waypoints
-from htetro_opt.errors import TilingError
 from htetro_opt.solvers.tiling import TILING_METHODS, find_tiles, tile_workspace
 
 WORKSPACES = ("tiling_6x6", "tiling_8x7", "tiling_10x10", "tiling_11x11")
@@ -319,7 +325,7 @@ def backends(quick: bool, budget: float) -> None:
     scenario = load_scenario("tiling_64x64")
     ts = tile_workspace(scenario.workspace, name=scenario.name)
     cases.append(("tiling_64x64 eq. 2 (open, tile 1)", SequencingInstance.from_tileset(ts, start=1), None))
-    runs = [("local", {}), ("local", {"restarts": 10**6, "time_limit": budget})]
+    runs = [("local", {}), ("local", {"restarts": 10**6, "time_limit": budget}), ("ils", {})]
     if have_fast:
         runs += [("fast-tsp", {"time_limit": 1.0}), ("fast-tsp", {"time_limit": budget})]
     if have_lkh:

@@ -82,7 +82,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="continuous scenarios (Nazarahari et al. 2019): ega (default): its enhanced GA with our "
                         "additions, ega-paper: as published, nsga2: pymoo's NSGA-II over the same path bases "
                         "(--pop-size 10, --max-gen 20 unless given), exact: the visibility-graph optimum, astar: "
-                        "A* on the --grid lattice. Grid scenarios: "
+                        "A* on the --grid lattice, prm: a roadmap of the paper's samples per map, rrt: OMPL's "
+                        "RRTConnect (the paper's B-RRT; pip install 'htetro-opt[ompl]'), pso: pymoo's PSO from the "
+                        "APF paths; each robot alone. Grid scenarios: "
                         "dijkstra (default), astar: the minimum-time plan (the same optimum); htetro-ga: the "
                         "multi-objective GA over command chromosomes of Cheng et al. 2020 with our additions "
                         "(htetro-ga-paper: as published); nsga2, nsga3, smsemoa, agemoea: pymoo's algorithms "
@@ -146,6 +148,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--robot-radius", metavar="R|SHAPE",
                    help="continuous: the robots' radius instead of the scenario's, a number or a morphology letter "
                         "(the disc around that hTetro footprint, e.g. O)")
+    p.add_argument("--time-limit", type=float, metavar="S",
+                   help="continuous, rrt: seconds per robot before giving up (default 120, the paper's)")
     p.add_argument("--clearance", type=float, default=0.0, help="clearance δ in cells around every block (default 0)")
     _add_outputs(p, plot="a plot of the map and the path", gif="an animated GIF of the plan, step by step")
 
@@ -227,10 +231,12 @@ def build_parser() -> argparse.ArgumentParser:
         "rate, gap to the exact reference). 'le2018' re-runs the tables of Le et al. 2018 beside the paper's; "
         "'do2021' those of Do et al. 2021 (Tables 6-8, Fig. 13; DIR/do2021.md and .csv hold its report); "
         "'cheng2019' those of Cheng et al. 2019 (Table 2, the 16 x 7 map, baselines and larger maps, every "
-        "coverage plan beside its lower bound; DIR/cheng2019.md and .csv hold its report).",
+        "coverage plan beside its lower bound; DIR/cheng2019.md and .csv hold its report); 'nazarahari2019' "
+        "those of Nazarahari et al. 2019 (Table 2, the (IS, PS) pairs, normalised weights, four robots, every "
+        "length beside the exact optimum; in this process; DIR/nazarahari2019.md and .csv).",
     )
     p.add_argument("study", metavar="NAME|FILE",
-                   help="a bundled study name, cheng2019, do2021, le2018, or a study TOML file")
+                   help="a bundled study name, cheng2019, do2021, le2018, nazarahari2019, or a study TOML file")
     p.add_argument("--executor", choices=("serial", "processes", "dask"), default="processes",
                    help="where trials run: this process, local worker processes (default), or a Dask cluster")
     p.add_argument("--workers", type=int, help="processes / dask: number of workers (default: the local cores)")
@@ -392,11 +398,11 @@ def _cmd_scenarios(args) -> dict:
     return {"scenarios": rows, "tilesets": tilesets}
 
 
-CONTINUOUS_ONLY_METHODS = ("ega", "ega-paper", "exact")
+CONTINUOUS_ONLY_METHODS = ("ega", "ega-paper", "exact", "prm", "rrt", "pso")
 """``plan --method`` names for continuous scenarios only (``astar`` and ``nsga2`` plan both kinds)."""
-_CONTINUOUS_METHODS = ("ega", "ega-paper", "nsga2", "exact", "astar")
+_CONTINUOUS_METHODS = ("ega", "ega-paper", "nsga2", "exact", "astar", "prm", "rrt", "pso")
 _CONTINUOUS_FLAGS = {"path": "--path", "normalise": "--normalise", "safety": "--safety", "grid": "--grid",
-                     "robot_radius": "--robot-radius"}
+                     "robot_radius": "--robot-radius", "time_limit": "--time-limit"}
 _GRID_FLAGS = {"patience": "--patience", "converge": "--converge", "max_length": "--max-length",
                "replan_window": "--replan-window", "replan_members": "--replan-members", "seed_exact": "--seed-exact",
                "pick": "--pick", "diagonals": "--diagonals", "t_max": "--t-max", "element": "--element",
@@ -445,7 +451,22 @@ def _cmd_plan_continuous(scenario, args) -> dict:
     if args.grid is not None:
         options["grid"] = check_real(args.grid, "--grid", minimum=0.0, include_minimum=False,
                                      maximum=min(scenario.width, scenario.height) / 2)
-    if genetic:
+    if args.time_limit is not None:
+        if method != "rrt":
+            raise ParameterError(f"--time-limit applies to --method rrt only, not to --method {method}")
+        options["time_limit"] = _cli_time_limit(args.time_limit)
+    ga_only = {"path": "--path", "safety": "--safety", "weights": "--weights", "normalise": "--normalise"}
+    if method in ("prm", "rrt", "pso"):  # the paper's seeded baselines, each robot alone
+        _only_for(args, ga_only, "the GA methods (ega, ega-paper, nsga2)")
+        options["seed"] = check_int(0 if args.seed is None else args.seed, "--seed", minimum=0)
+        if method == "pso":
+            options.update(pop_size=check_int(10 if args.pop_size is None else args.pop_size, "--pop-size", minimum=2),
+                           max_gen=check_int(20 if args.max_gen is None else args.max_gen, "--max-gen", minimum=0))
+        else:
+            _only_for(args, {"pop_size": "--pop-size", "max_gen": "--max-gen"}, "the GA methods and pso")
+            if args.grid is not None:
+                raise ParameterError(f"--grid applies to --method astar, pso and the GA methods, not to {method}")
+    elif genetic:
         options.update(pop_size=check_int(10 if args.pop_size is None else args.pop_size, "--pop-size", minimum=2),
                        max_gen=check_int(20 if args.max_gen is None else args.max_gen, "--max-gen", minimum=0),
                        seed=check_int(0 if args.seed is None else args.seed, "--seed", minimum=0))
@@ -954,6 +975,8 @@ def _study_folder(out: str | None) -> Path | None:
 
 
 def _cmd_study(args) -> dict:
+    if args.study == "nazarahari2019":
+        return _nazarahari2019(args)
     if args.study == "le2018":
         if args.figures:
             raise ParameterError("--figures applies to cheng2019 only, not to study 'le2018'")
@@ -1064,6 +1087,32 @@ def _cheng2019(args, study, seeds, workers, retries, out) -> dict:
         print(cheng2019.report(run, figures=figures), end="")
         if run.path is not None:
             print(f"\n{len(run.records)} trials ({run.failed} failed) recorded in {run.path}")
+    return result
+
+
+def _nazarahari2019(args) -> dict:
+    """Nazarahari et al. 2019's Table 2, §5.1, §5.3 and four robots beside the paper's, in this process
+    (every trial needs its map's exact optimum; the runner's tasks plan grid scenarios)."""
+    from htetro_opt.studies import nazarahari2019
+
+    given = [flag for name, flag in (("figures", "--figures"), ("resume", "--resume"), ("scheduler", "--scheduler"),
+                                     ("workers", "--workers"), ("time_limit", "--time-limit"))
+             if getattr(args, name, None) not in (None, False)]
+    if given or args.retries or args.executor not in ("processes", "serial"):
+        raise ParameterError(f"{', '.join(given) or '--executor/--retries'} does not apply to nazarahari2019 "
+                             "(it runs in this process; options: --seeds, --out)")
+    seeds = check_int(5 if args.seeds is None else args.seeds, "--seeds", minimum=1)
+    out = _study_folder(args.out)
+    console = _console(args)
+    with console.step("nazarahari2019 study", None, "trials") as progress:
+        run = nazarahari2019.run_nazarahari2019(seeds, progress=progress)
+    text = nazarahari2019.report(run)
+    result = {"study": "nazarahari2019", "seeds": run.seeds, "exact": run.exact, "table2": run.table2,
+              "pairs": run.pairs, "normalised": run.normalised, "cross4": run.cross4, "seconds": run.seconds}
+    if out is not None:
+        _late(result, lambda: nazarahari2019.write_report(out, run))
+    if not args.json:
+        print(text, end="")
     return result
 
 

@@ -10,6 +10,9 @@
 - :mod:`htetro_opt.studies.cheng2019`: Cheng et al. 2019's Table 2 (complete coverage over seven
   morphology sets and two stripe widths, by our reading and by the paper's Alg. 5), its 16 × 7 map,
   two baselines and two larger maps, every plan beside its lower bound;
+- :mod:`htetro_opt.studies.nazarahari2019`: Nazarahari et al. 2019's Table 2 (12 continuous maps × A*,
+  PRM, B-RRT, PSO and the enhanced GA), §5.1's (IS, PS) pairs, §5.3's weights and four robots, every
+  length beside the exact optimum;
 - :mod:`htetro_opt.studies.metrics`: mean ± standard deviation aggregation over trial records.
 
 Studies may use the model, problems, solvers and scenarios, never the plotting or the command line.

@@ -11,18 +11,21 @@ import numpy as np
 from htetro_opt.errors import ParameterError, PlanningError
 from htetro_opt.solvers.continuous._astar import plan_astar
 from htetro_opt.solvers.continuous._exact import plan_exact
+from htetro_opt.solvers.continuous._prm import plan_prm
+from htetro_opt.solvers.continuous._rrt import plan_rrt
 from htetro_opt.solvers.continuous._result import ContinuousPlan, check_scenario, finish_plan
 
 __all__ = ["CONTINUOUS_METHODS", "plan_continuous"]
 
-_METHODS = {"exact": plan_exact, "astar": plan_astar, "ega": "plan_ega", "ega-paper": "plan_ega_paper",
-            "nsga2": "plan_nsga2"}  # the GAs load pymoo: imported when asked for
+_METHODS = {"exact": plan_exact, "astar": plan_astar, "prm": plan_prm, "rrt": plan_rrt,
+            "ega": "_ega.plan_ega", "ega-paper": "_ega.plan_ega_paper", "nsga2": "_ega.plan_nsga2",
+            "pso": "_pso.plan_pso"}  # the GAs and the PSO load pymoo: imported when asked for
 
 CONTINUOUS_METHODS = tuple(_METHODS)
 """Method names :func:`plan_continuous` knows: ``"exact"`` (the visibility-graph reference),
-``"astar"`` (the lattice baseline of Nazarahari et al. 2019), ``"ega"`` and ``"ega-paper"`` (its
-enhanced GA, with our additions or as published) and ``"nsga2"`` (pymoo's NSGA-II over the same path
-bases)."""
+``"astar"``, ``"prm"``, ``"rrt"`` and ``"pso"`` (the baselines of Nazarahari et al. 2019), ``"ega"``
+and ``"ega-paper"`` (its enhanced GA, with our additions or as published) and ``"nsga2"`` (pymoo's
+NSGA-II over the same path bases)."""
 
 
 def plan_continuous(scenario, *, method: str | Callable = "exact", **options) -> ContinuousPlan:
@@ -40,6 +43,15 @@ def plan_continuous(scenario, *, method: str | Callable = "exact", **options) ->
           with the lower bound in ``info`` (no options);
         - ``"astar"``: A* on the 8-connected lattice of spacing ``grid`` (default 1.0; the paper
           also uses 0.25), each robot alone;
+        - ``"prm"``: the shortest path over a roadmap of exactly ``n`` uniform free samples joined
+          within ``radius`` (default: the paper's per map), then deletion, each robot alone
+          (:func:`~htetro_opt.solvers.continuous.plan_prm`: options ``n``, ``radius``, ``seed``);
+        - ``"rrt"``: OMPL's RRTConnect (the paper's B-RRT, step 2), then deletion, each robot alone
+          (:func:`~htetro_opt.solvers.continuous.plan_rrt`: options ``time_limit`` (120 s),
+          ``seed``; needs the optional OMPL: ``pip install 'htetro-opt[ompl]'``);
+        - ``"pso"``: pymoo's particle swarm over the path bases from the APF's paths, each robot
+          alone (:func:`~htetro_opt.solvers.continuous.plan_pso`: options ``pop_size``,
+          ``max_gen``, ``grid``, ``seed``);
         - ``"ega"``: Nazarahari et al. 2019's enhanced GA over path bases with our additions, all
           robots jointly (:func:`~htetro_opt.solvers.continuous.plan_ega`: options ``path``,
           ``weights`` or ``normalise``, ``safety``, ``grid``, ``pop_size``, ``max_gen``, ``seed``);
@@ -67,7 +79,8 @@ def plan_continuous(scenario, *, method: str | Callable = "exact", **options) ->
         For a grid scenario (or anything but a continuous one).
     ParameterError
         On an unknown method, an option the method does not take or a bad option value (``grid`` ≤ 0
-        or above min(W, H) / 2, bad weights, an unknown ``path`` or ``safety``).
+        or above min(W, H) / 2, bad weights, an unknown ``path`` or ``safety``); ``"rrt"`` without
+        OMPL installed.
     PlanningError
         If a callable method returns a path that is not an (n, 2) array from the start to the goal,
         or that collides.
@@ -93,9 +106,10 @@ def plan_continuous(scenario, *, method: str | Callable = "exact", **options) ->
                              f"{', '.join(CONTINUOUS_METHODS)} or a callable")
     function = _METHODS[method]
     if isinstance(function, str):
-        from htetro_opt.solvers.continuous import _ega
+        import importlib
 
-        function = getattr(_ega, function)
+        module, name = function.split(".")
+        function = getattr(importlib.import_module(f"htetro_opt.solvers.continuous.{module}"), name)
     known = [name for name, p in inspect.signature(function).parameters.items() if p.kind is p.KEYWORD_ONLY]
     unknown = sorted(set(options) - set(known))
     if unknown:

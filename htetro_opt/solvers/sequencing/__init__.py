@@ -7,7 +7,10 @@ function of its own:
 - ``exact`` (:func:`solve_exact`): the CP-SAT optimum with a proof, up to 40 waypoints;
   :func:`held_karp` is the independent dynamic-programming reference (≤ 16);
 - ``ortools`` (:func:`solve_ortools`): OR-Tools routing with guided local search, the paper's baseline;
-- ``local`` (:func:`solve_local`): nearest neighbour, 2-opt and Or-opt, optionally iterated;
+- ``ils`` (:func:`solve_ils`): the compiled (numba), seeded iterated local search — 2-opt and Or-opt
+  with neighbour lists and don't-look bits, local double-bridge kicks — ``auto``'s engine beyond the
+  exact range;
+- ``local`` (:func:`solve_local`): nearest neighbour, 2-opt and Or-opt, optionally iterated (pure numpy);
   :func:`nearest_neighbour_paths` is the one nearest-neighbour construction (the exact solver's
   hint and the greedy baseline use it too), :func:`improve` / :func:`improve_batch` the one
   2-opt/Or-opt local search (the memetic GA uses it too);
@@ -35,5 +38,6 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "solve_ga": "._ga", "make_toolbox": "._ga",
     "solve_zigzag": "._baselines", "solve_spiral": "._baselines", "solve_greedy": "._baselines",
     "PATTERN_VARIANTS": "._baselines",
+    "solve_ils": "._ils", "ils_kicks": "._ils", "ILS_NEIGHBOURS": "._ils", "ILS_KICK_SPAN": "._ils",
     "solve_fast_tsp": "._backends", "solve_lkh": "._backends", "FAST_TSP_CANDIDATES": "._backends",
 })

@@ -13,12 +13,13 @@ __all__ = ["default_time_limit", "TIME_LIMIT_TEXT"]
 
 # method → (base seconds, waypoints per extra second, cap seconds)
 _LINEAR = {"ga": (10.0, 50, 60.0), "ga-plain": (10.0, 50, 60.0), "greedy": (10.0, 100, 30.0),
-           "local": (10.0, 100, 120.0), "fast-tsp": (0.5, 400, 30.0)}
+           "local": (10.0, 100, 120.0), "fast-tsp": (0.5, 400, 30.0), "ils": (60.0, 20, 600.0)}
 
 TIME_LIMIT_TEXT = ("exact: 60 s; ortools: 1 s up to 20 waypoints, rising to 30 s at 40 and beyond; "
                    "ga, ga-plain: 10 s + 1 s per 50 waypoints, at most 60 s; greedy: 10 s + 1 s per 100 "
                    "waypoints, at most 30 s; local: 10 s + 1 s per 100 waypoints, at most 120 s; "
-                   "fast-tsp: 0.5 s + 1 s per 400 waypoints, at most 30 s; lkh: none (its runs); "
+                   "fast-tsp: 0.5 s + 1 s per 400 waypoints, at most 30 s; ils (a safety cap: its budget "
+                   "is its kicks): 60 s + 1 s per 20 waypoints, at most 600 s; lkh: none (its runs); "
                    "zigzag, spiral: none (instant)")
 """The defaults of :func:`default_time_limit`, in words (the CLI's help shows it)."""
 

@@ -26,10 +26,20 @@ import numpy as np
 from htetro_opt._progress import check_progress
 from htetro_opt._validation import check_seed, check_time_limit
 from htetro_opt.errors import ParameterError
-from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance, reduce_to_open_path
+from htetro_opt.problems.waypoint_sequencing import (
+    SequencingInstance,
+    check_instance,
+    reduce_to_open_path,
+)
 
-__all__ = ["SEQUENCE_METHODS", "ASYMMETRIC_METHODS", "EXACT_AUTO_LIMIT", "SequenceResult", "auto_method",
-           "sequence_waypoints"]
+__all__ = [
+    "ASYMMETRIC_METHODS",
+    "EXACT_AUTO_LIMIT",
+    "SEQUENCE_METHODS",
+    "SequenceResult",
+    "auto_method",
+    "sequence_waypoints",
+]
 
 # name → (module, function, preset options, capabilities): "asymmetric" (asymmetric costs allowed),
 # "tours" (closed tours and fixed ends taken natively), "geometry" (needs the tiles' block cells)
@@ -37,6 +47,7 @@ _METHODS = {
     "exact": ("._exact", "solve_exact", {}, {"asymmetric"}),
     "ortools": ("._ortools", "solve_ortools", {}, {"asymmetric"}),
     "local": ("._local", "solve_local", {}, set()),
+    "ils": ("._ils", "solve_ils", {}, {"tours"}),
     # the memetic GA finds its best within a few generations; 50 more without improvement suffice
     "ga": ("._ga", "solve_ga", {"memetic": True, "patience": 50}, set()),
     "ga-plain": ("._ga", "solve_ga", {"memetic": False}, set()),
@@ -93,15 +104,14 @@ def auto_method(instance: SequencingInstance) -> str:
     """The method ``method="auto"`` runs on ``instance``.
 
     ``exact`` up to :data:`EXACT_AUTO_LIMIT` waypoints (a closed tour counts its copied first
-    waypoint too). Beyond, ``local`` for symmetric costs and ``ortools`` for asymmetric ones.
+    waypoint too). Beyond, for symmetric costs, ``ils`` (the compiled iterated local search, whose
+    budget is counted in kicks: the same seed gives the same order on every machine; numba, which
+    compiles it, is a core dependency); ``ortools`` for asymmetric costs.
 
-    Not ``fast-tsp``, although it is clearly better where measured (benchmarks/README.md,
-    "Sequencing backends": within 0.05 % of LKH-3 after 1 s on 200 and 1000 uniform points and on
-    the 1004 eq.-2 waypoints of tiling_64x64, where ``local`` stops 5.1 %, 5.0 % and 2.5 % above):
-    it takes no seed and stops on the clock, so its result depends on the machine's load, and the
-    default must give the same result for the same seed on every machine, whatever optional
-    packages are installed. Ask for it with ``method="fast-tsp"``; ``lkh`` is deterministic but its
-    licence is non-commercial.
+    Not ``fast-tsp``, although it is as good or better where measured (benchmarks/README.md,
+    "Sequencing backends"): it takes no seed and stops on the clock, so its result depends on the
+    machine's load, and the default must give the same result for the same seed on every machine.
+    Ask for it with ``method="fast-tsp"``; ``lkh`` is deterministic but its licence is non-commercial.
 
     Examples
     --------
@@ -115,7 +125,7 @@ def auto_method(instance: SequencingInstance) -> str:
         return "exact"
     if not instance.symmetric:
         return "ortools"
-    return "local"
+    return "ils"
 
 
 def _resolve(method, instance: SequencingInstance) -> tuple[str, object, dict, set]:
@@ -146,8 +156,8 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, t
         Costs, block cells and start.
     method : str or callable, keyword-only
         One of :data:`SEQUENCE_METHODS`. ``auto`` is the exact solver up to
-        :data:`EXACT_AUTO_LIMIT` waypoints and, beyond, fast-tsp when it is installed, else the
-        local search (ortools for asymmetric costs): :func:`auto_method`. A callable
+        :data:`EXACT_AUTO_LIMIT` waypoints and, beyond, the compiled iterated local search ``ils``
+        (ortools for asymmetric costs): :func:`auto_method`. A callable
         ``method(instance, *, seed, time_limit, **options)`` returning ``(order, info)`` is run the
         same way (given the open-path reduction of a closed tour or a fixed end).
     seed : None, int or numpy.random.Generator, keyword-only
@@ -159,7 +169,8 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, t
         default, sized to the instance (:func:`default_time_limit`: exact 60 s; ortools 1 s up to 20
         waypoints, rising to 30 s at 40; ga, ga-plain 10 s + 1 s per 50 waypoints, at most 60 s;
         greedy 10 s + 1 s per 100 waypoints, at most 30 s; local 10 s + 1 s per 100 waypoints, at
-        most 120 s; fast-tsp 0.5 s + 1 s per 400 waypoints, at most 30 s).
+        most 120 s; fast-tsp 0.5 s + 1 s per 400 waypoints, at most 30 s; ils, whose budget is
+        its kicks, a safety cap of 60 s + 1 s per 20 waypoints, at most 600 s).
     progress : callable, optional, keyword-only
         ``progress(done, total, note)`` from the methods that report (ga, ga-plain, greedy, local,
         ortools; a callable method that takes a ``progress`` keyword), see :mod:`htetro_opt._progress`.

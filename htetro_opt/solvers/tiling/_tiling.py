@@ -110,7 +110,13 @@ import numpy as np
 from scipy import ndimage
 
 from htetro_opt._interrupt import on_signal
-from htetro_opt._validation import check_bool, check_int, check_seed, check_time_limit, derive_seed
+from htetro_opt._validation import (
+    check_bool,
+    check_int,
+    check_seed,
+    check_time_limit,
+    derive_seed,
+)
 from htetro_opt.errors import ParameterError, ScenarioError, TilingError
 from htetro_opt.model.tiles import Pattern, patterns_of
 from htetro_opt.model.workspace import Workspace

@@ -19,7 +19,9 @@ def run(capsys, *argv):
 
 
 @pytest.mark.parametrize("method, extra", [("ega", []), ("ega-paper", ["--max-gen", "5"]),
-                                           ("nsga2", ["--max-gen", "5"]), ("exact", []), ("astar", ["--grid", "0.5"])])
+                                           ("nsga2", ["--max-gen", "5"]), ("exact", []), ("astar", ["--grid", "0.5"]),
+                                           ("prm", ["--seed", "2"]), ("rrt", ["--time-limit", "5"]),
+                                           ("pso", ["--pop-size", "6", "--max-gen", "5", "--grid", "0.5"])])
 def test_json_keys_per_method(capsys, method, extra):
     code, out, err = run(capsys, "ega08_slits2", "--method", method, "--json", *extra)
     assert code == 0, err
@@ -74,11 +76,26 @@ def test_weights_normalise_radius_and_text_output(capsys, tmp_path):
     (["ega07_slits1", "--robot-radius", "Q"], "robot_radius must be"),
     (["ega07_slits1", "--robot-radius", "3"], "(radius 3) lies outside"),
     (["ega07_slits1", "--pop-size", "1"], "--pop-size"),
+    (["ega07_slits1", "--method", "ega", "--time-limit", "5"], "--time-limit applies to --method rrt only"),
+    (["ega07_slits1", "--method", "rrt", "--time-limit", "0"], "--time-limit (seconds) must be"),
+    (["ega07_slits1", "--method", "rrt", "--path", "spline"], "--path applies to the GA methods"),
+    (["ega07_slits1", "--method", "prm", "--pop-size", "5"], "--pop-size applies to the GA methods and pso"),
+    (["ega07_slits1", "--method", "prm", "--grid", "0.5"], "--grid applies to --method astar, pso"),
+    (["ega07_slits1", "--method", "pso", "--weights", "1,0,0"], "--weights applies to the GA methods"),
+    (["three_slit", "--method", "prm"], "plans continuous scenarios"),
+    (["three_slit", "--time-limit", "3"], "--time-limit applies to continuous scenarios only"),
 ])
 def test_bad_inputs_give_one_error_line_and_exit_2(capsys, argv, words):
     code, out, err = run(capsys, *argv)
     assert code == 2 and out == ""
     assert err.count("\n") == 1 and err.startswith("error: ") and words in err, err
+
+
+def test_baseline_seeds_repeat_on_the_command_line(capsys):
+    for method in ("prm", "rrt", "pso"):
+        first = run(capsys, "ega01_random1", "--method", method, "--seed", "3", "--json")[1]
+        again = run(capsys, "ega01_random1", "--method", method, "--seed", "3", "--json")[1]
+        assert json.loads(first)["paths"] == json.loads(again)["paths"], method
 
 
 def test_the_readme_synopsis_line_matches_the_parser():

@@ -149,13 +149,13 @@ def test_the_patterns_refuse_a_plain_matrix(method):
 
 def test_auto_runs_exact_small_local_large_and_ortools_on_large_asymmetric():
     assert auto_method(SequencingInstance.from_matrix(euclidean(40, 0))) == "exact"
-    assert auto_method(SequencingInstance.from_matrix(euclidean(40, 0), closed=True)) == "local"  # 41 with the copy
+    assert auto_method(SequencingInstance.from_matrix(euclidean(40, 0), closed=True)) == "ils"  # 41 with the copy
     assert auto_method(SequencingInstance.from_matrix(euclidean(39, 0), closed=True)) == "exact"
     assert auto_method(SequencingInstance.from_matrix(asymmetric(41, 0))) == "ortools"
     # never fast-tsp (installed here): no seed, stops on the clock; the default must reproduce
     instance = SequencingInstance.from_matrix(euclidean(45, 0), closed=True)
     first, again = sequence_waypoints(instance, seed=3), sequence_waypoints(instance, seed=3)
-    assert first.method == "auto (local)" and first.order.tolist() == again.order.tolist()
+    assert first.method == "auto (ils)" and first.order.tolist() == again.order.tolist()
 
 
 def test_a_tileset_instance_can_be_closed_or_end_at_a_tile_with_the_patterns_too():

@@ -242,4 +242,4 @@ def test_auto_proves_small_instances_and_searches_with_the_local_search_beyond_t
     assert result.method == "auto (exact)" and result.info["optimal"]
     assert result.cost == pytest.approx(held_karp(small.cost, start=2)[1], rel=1e-9)
     big = random_instance("euclid", 1, 41, 0)
-    assert sequence_waypoints(big, time_limit=0.2).method == "auto (local)"  # fast-tsp, installed, is not reproducible
+    assert sequence_waypoints(big, time_limit=0.2).method == "auto (ils)"  # fast-tsp, installed, is not reproducible

@@ -25,7 +25,7 @@ from htetro_opt.solvers.sequencing import (
 )
 
 # Options that keep each method fast here; with them every method runs in well under a second.
-FAST = {"exact": {}, "ortools": {"time_limit": 0.1}, "local": {"restarts": 5}, "ga": {"patience": 5},
+FAST = {"exact": {}, "ortools": {"time_limit": 0.1}, "local": {"restarts": 5}, "ils": {"kicks": 200}, "ga": {"patience": 5},
         "ga-plain": {"max_gen": 20}, "zigzag": {}, "zigzag2": {}, "spiral": {}, "spiral2": {},
         "greedy": {"iterations": 20}, "fast-tsp": {"time_limit": 0.1}, "lkh": {}}
 FUNCTIONS = [solve_exact, solve_ortools, solve_local, solve_ga, solve_greedy, solve_zigzag, solve_spiral,
@@ -163,4 +163,4 @@ def test_auto_chooses_by_size():
     assert sequence_waypoints(SequencingInstance(cost_matrix(small), small, 0)).method == "auto (exact)"
     large = rng.integers(0, 50, (41, 4, 2))
     # never fast-tsp, although installed by the test extra: it is not reproducible (no seed, stops on the clock)
-    assert sequence_waypoints(SequencingInstance(cost_matrix(large), large, 0)).method == "auto (local)"
+    assert sequence_waypoints(SequencingInstance(cost_matrix(large), large, 0)).method == "auto (ils)"

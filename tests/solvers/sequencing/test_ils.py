@@ -1,0 +1,107 @@
+"""The compiled iterated local search (``ils``): valid orders, reproducible by seed, never below a proven
+optimum, at the optimum on small instances, and better than the numpy ``local`` on larger ones."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+from htetro_opt.errors import ParameterError
+from htetro_opt.problems import SequencingInstance
+from htetro_opt.solvers.sequencing import (
+    auto_method,
+    held_karp,
+    ils_kicks,
+    sequence_waypoints,
+)
+
+pytest.importorskip("numba")
+
+
+def euclidean(n, seed):
+    xy = np.random.default_rng(seed).random((n, 2)) * 100
+    return np.sqrt(((xy[:, None] - xy[None]) ** 2).sum(-1))
+
+
+def brute_force(C, closed, start, end):
+    """Independent oracle for ≤ 8 waypoints: every permutation."""
+    from itertools import permutations
+
+    n = len(C)
+    best = np.inf
+    for p in permutations(range(n)):
+        if (start is not None and p[0] != start) or (end is not None and p[-1] != end):
+            continue
+        cost = sum(C[a, b] for a, b in itertools.pairwise(p)) + (C[p[-1], p[0]] if closed else 0.0)
+        best = min(best, cost)
+    return best
+
+
+@pytest.mark.parametrize("closed, start, end", [(False, 0, None), (False, None, None), (False, 2, 5),
+                                                (False, None, 4), (True, 0, None), (True, None, None)])
+def test_small_instances_reach_the_optimum(closed, start, end):
+    for seed in range(6):
+        C = euclidean(8, seed)
+        inst = SequencingInstance.from_matrix(C, closed=closed, start=start, end=end)
+        result = sequence_waypoints(inst, method="ils", seed=seed)
+        order = result.order.tolist()
+        assert sorted(order) == list(range(8))
+        priced = sum(C[a, b] for a, b in itertools.pairwise(order)) + (C[order[-1], order[0]] if closed else 0.0)
+        assert result.cost == pytest.approx(priced)
+        assert result.cost == pytest.approx(brute_force(C, closed, start, end), rel=1e-9)
+
+
+def test_never_below_the_held_karp_optimum_over_seeds():
+    for seed in range(10):
+        C = euclidean(14, 100 + seed)
+        inst = SequencingInstance.from_matrix(C, start=0)
+        optimum = held_karp(C, start=0)[1]
+        result = sequence_waypoints(inst, method="ils", seed=seed)
+        assert result.cost >= optimum - 1e-9
+        assert result.cost == pytest.approx(optimum, rel=1e-9)
+
+
+def test_same_seed_same_order_and_the_budget_is_kicks():
+    C = euclidean(300, 3)
+    inst = SequencingInstance.from_matrix(C, closed=True)
+    a = sequence_waypoints(inst, method="ils", seed=5, kicks=20_000)
+    b = sequence_waypoints(inst, method="ils", seed=5, kicks=20_000)
+    c = sequence_waypoints(inst, method="ils", seed=6, kicks=20_000)
+    assert np.array_equal(a.order, b.order) and a.info["kicks"] == 20_000 and not a.info["timed_out"]
+    assert not np.array_equal(a.order, c.order)  # another seed, another walk (and here another tour)
+    assert ils_kicks(300) > 20_000
+
+
+def test_better_than_numpy_local_at_a_like_time():
+    C = euclidean(400, 9)
+    inst = SequencingInstance.from_matrix(C, start=0)
+    ils = sequence_waypoints(inst, method="ils", seed=0, kicks=40_000)
+    local = sequence_waypoints(inst, method="local", seed=0)
+    assert ils.cost < 0.98 * local.cost
+
+
+def test_time_cap_is_reported():
+    inst = SequencingInstance.from_matrix(euclidean(2000, 1), closed=True)
+    result = sequence_waypoints(inst, method="ils", time_limit=0.05)
+    assert result.info["timed_out"] and result.info["kicks"] < ils_kicks(2001)
+    assert sorted(result.order.tolist()) == list(range(2000))
+
+
+def test_auto_runs_ils_beyond_the_exact_range_and_refuses_nothing_it_should_not():
+    inst = SequencingInstance.from_matrix(euclidean(60, 2), start=0)
+    assert auto_method(inst) == "ils"
+    assert sequence_waypoints(inst, kicks=1000).method == "auto (ils)"
+    asymmetric = euclidean(10, 1) + np.triu(np.ones((10, 10)))
+    with pytest.raises(ParameterError, match="symmetric"):
+        sequence_waypoints(SequencingInstance.from_matrix(asymmetric), method="ils")
+    for bad in (-1, 1.5):
+        with pytest.raises(ParameterError, match="kicks"):
+            sequence_waypoints(inst, method="ils", kicks=bad)
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4, 5])
+def test_tiny_instances(n):
+    C = euclidean(n, 0)
+    for closed, start in ((False, 0), (False, None), (True, None)):
+        result = sequence_waypoints(SequencingInstance.from_matrix(C, closed=closed, start=start), method="ils")
+        assert sorted(result.order.tolist()) == list(range(n))

@@ -1,0 +1,46 @@
+"""Nazarahari et al. 2019's study: the paper's Table 2 as read (garbles kept), a small run's report
+with every section, and its command-line entry."""
+
+import pytest
+
+from htetro_opt.studies import nazarahari2019 as study
+
+
+def test_paper_table2_has_every_map_and_row_and_the_brrt_failures():
+    assert set(study.PAPER_TABLE2) == set(study.MAPS)
+    for name, rows in study.PAPER_TABLE2.items():
+        assert set(rows) == set(study.METHODS) - {"EGA-paper"}, name
+        assert all(len(r) == 7 for r in rows.values())
+    failed = {n for n, rows in study.PAPER_TABLE2.items() if rows["B-RRT"][6] == 0}
+    assert failed == {"ega02_maze1", "ega03_home", "ega09_maze2", "ega10_maze3"}
+    assert study.PAPER_TABLE2["ega01_random1"]["A* 1"][0] == 35.79
+    assert study.PAPER_TABLE2["ega04_corridor1"]["EGA spline"][:2] == (33.57, 0.2)  # printed so
+
+
+def test_a_small_run_reports_every_section(tmp_path):
+    run = study.run_nazarahari2019(1, maps=("ega07_slits1",), methods=("A* 1", "PRM", "EGA linear"),
+                                   pairs=((20, 10),))
+    text = study.report(run)
+    for words in ("## Table 2", "ega07_slits1 (exact optimum 64.43)", "| EGA linear | 64.43 ± 0.00 | +0.00",
+                  "## §5.1", "## Four robots"):
+        assert words in text, words
+    assert "§5.3" not in text  # map 4 not in this run
+    ok = [r for r in run.table2 if r["reached"]]
+    assert all(r["length"] >= run.exact["ega07_slits1"] - 1e-9 for r in ok)
+    md, table = study.write_report(tmp_path, run)
+    assert md.read_text() == text and table.read_text().count("\n") == 1 + len(run.table2) + len(run.pairs)
+
+
+def test_the_command_line_names_bad_seeds(capsys):
+    from htetro_opt.cli import main
+
+    assert main(["study", "nazarahari2019", "--seeds", "0"]) == 2
+    assert "--seeds" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_the_papers_fifty_seeds():
+    run = study.run_nazarahari2019(50)
+    ega = [r for r in run.table2 if r["method"] == "EGA linear"]
+    assert all(r["reached"] for r in ega)
+    assert all(r["length"] <= 1.005 * run.exact[r["map"]] for r in ega)
