@@ -282,13 +282,14 @@ class _LegSearch:
         while nodes[-1] != start:
             nodes.append(int(pred[nodes[-1]]))
         nodes.reverse()
+        column_of = np.flatnonzero(self.repeatable)  # layer k's command is column_of[k - 1]
         steps = []
         for a, b in zip(nodes[:-1], nodes[1:]):
             (la, pa), (lb, pb) = divmod(a, n), divmod(b, n)
-            if la > 0 and lb == 0:  # into the hub: no command
+            if lb == 0 and la > 0:  # a layer into the hub, at the same pose: no command
                 continue
-            steps.append(int(np.flatnonzero(self.layer_of == la)[0]) if la > 0
-                         else self.graph.step_command(pa, pb, 0))
+            # into layer k the command is k's (a repeat, or a change from the hub); hub to hub, a shapeshift
+            steps.append(int(column_of[lb - 1]) if lb > 0 else self.graph.step_command(pa, pb, 0))
         return steps, float(dist[end])
 
 
