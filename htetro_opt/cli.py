@@ -107,11 +107,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int,
                    help=f"GA methods: random seed, the same seed giving the same plan (default {GA_DEFAULTS['seed']})")
     p.add_argument("--replan-window", type=int, metavar="W",
-                   help="htetro-ga: windowed exact re-planning of ours, each generation a window of up to W executed "
+                   help="GA methods: windowed exact re-planning of ours, each generation a window of up to W executed "
                         "commands of the fastest and of --replan-members random goal-reaching members replaced by the "
-                        "minimum-time path between its ends (default 40; 0: off; off in htetro-ga-paper)")
+                        "minimum-time path between its ends (default 40 in htetro-ga; off (0) in htetro-ga-paper and "
+                        "pymoo's algorithms, which take it through their mating when given)")
     p.add_argument("--replan-members", type=int, metavar="K",
-                   help="htetro-ga: random goal-reaching members re-planned each generation besides the fastest (default 3)")
+                   help="GA methods: random goal-reaching members re-planned each generation besides the fastest "
+                        "(default 3)")
     p.add_argument("--seed-exact", action="store_true", default=None,
                    help="GA methods: put each leg's exact minimum-time plan into its initial population; the JSON "
                         "then reports the gaps to the exact optimum")

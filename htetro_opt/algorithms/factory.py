@@ -10,7 +10,10 @@ from __future__ import annotations
 from math import comb
 from typing import Mapping, Sequence
 
-from htetro_opt._validation import check_int, check_probability
+from pymoo.core.infill import InfillCriterion
+from pymoo.core.population import Population
+
+from htetro_opt._validation import check_int, check_probability, check_real
 from htetro_opt.algorithms.htetro_ga import HTetroGA
 from htetro_opt.errors import ParameterError
 from htetro_opt.operators.commands import (
@@ -18,10 +21,56 @@ from htetro_opt.operators.commands import (
     CommandDuplicateElimination,
     CommandMutation,
     CommandRepair,
+    CommandReplan,
     CommandSampling,
+    replan_rows,
 )
 
-__all__ = ["GA_ALGORITHMS", "make_algorithm"]
+__all__ = ["GA_ALGORITHMS", "ReplanMating", "make_algorithm"]
+
+_PYMOO_REPLAN = (0, 3)  # pymoo's algorithms: the re-planning off unless asked for (W), K when it is on
+
+
+class ReplanMating(InfillCriterion):
+    """A pymoo algorithm's own mating, followed by the hTetro-GA's windowed exact re-planning step.
+
+    Each generation the wrapped mating makes its offspring as usual (the algorithm's selection,
+    crossover, mutation, repair, duplicate elimination); then the fastest goal-reaching member of
+    the population and ``members`` random reaching ones (:func:`~htetro_opt.operators.commands.replan_rows`)
+    are re-planned (:class:`~htetro_opt.operators.commands.CommandReplan`) and those that changed,
+    less the duplicates, join the offspring. The offspring then number up to n_offsprings + 1 +
+    ``members``; every pymoo survival used here cuts pop + off back to pop_size. This is the step the
+    hTetro-GA takes (ours, see :class:`HTetroGA`), given to pymoo's algorithms through their
+    ``mating`` so that swapping the algorithm compares algorithms, not operator sets.
+
+    Parameters
+    ----------
+    mating : pymoo Mating
+        The algorithm's own (``algorithm.mating`` as pymoo built it).
+    window : int
+        W (at least 1).
+    members : int
+        K.
+    """
+
+    def __init__(self, mating, window: int, members: int) -> None:
+        super().__init__(repair=mating.repair, eliminate_duplicates=mating.eliminate_duplicates,
+                         n_max_iterations=mating.n_max_iterations)
+        self.mating = mating
+        self.replan = CommandReplan(check_int(window, "replan_window", minimum=1))
+        self.members = check_int(members, "replan_members", minimum=0)
+
+    def do(self, problem, pop, n_offsprings, random_state=None, **kwargs):
+        off = self.mating.do(problem, pop, n_offsprings, random_state=random_state, **kwargs)
+        F = pop.get("F")
+        if F is None or len(pop) == 0:
+            return off
+        rows = replan_rows(F[:, 0] <= -1.0, F[:, 1], self.members, random_state=random_state)  # F = −fitness
+        if not len(rows):
+            return off
+        replanned = self.replan.do(problem, Population.new(X=pop.get("X")[rows]), random_state=random_state)
+        replanned = self.eliminate_duplicates.do(replanned, pop, off)
+        return Population.merge(off, replanned) if len(replanned) else off
 
 GA_ALGORITHMS = ("htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea")
 """Algorithm names :func:`make_algorithm` knows: the hTetro-GA with our additions, as published, and
@@ -36,6 +85,7 @@ def make_algorithm(
     crossover_rate: float = 0.5,
     replan_window: int | None = None,
     replan_members: int | None = None,
+    reach_share: float | None = None,
     include: Sequence = (),
 ):
     """A pymoo algorithm over command chromosomes.
@@ -54,7 +104,11 @@ def make_algorithm(
     replan_window, replan_members : int, optional
         The hTetro-GA's windowed exact re-planning (:class:`HTetroGA`); None: the algorithm's
         default (W = 40 and 3 members for ``"htetro-ga"``, off for ``"htetro-ga-paper"``). pymoo's
-        algorithms have no re-planning step (yet): a window other than 0 is refused there.
+        algorithms take the same step through their mating (:class:`ReplanMating`), off by default
+        (their defaults stay pymoo's); with a window and no ``replan_members``, K = 3.
+    reach_share : float, optional
+        The hTetro-GA's cap on the goal-reaching section of its sort (:class:`HTetroGA`); None: the
+        default, 1 (no cap). pymoo's algorithms have no such sort: a share other than 1 is refused there.
     include : sequence of int arrays
         Chromosomes put into the initial population (:class:`CommandSampling`'s ``include``).
 
@@ -62,9 +116,9 @@ def make_algorithm(
     ------
     ParameterError
         If the name is unknown, ``pop_size`` is below 2, ``crossover_rate`` is not a probability, a
-        sampling weight is negative, ``replan_window`` or ``replan_members`` is negative or given to
-        one of pymoo's algorithms, or ``"agemoea"`` is asked for without numba installed (pymoo's
-        AGE-MOEA needs it: the ``agemoea`` extra).
+        sampling weight is negative, ``replan_window`` or ``replan_members`` is negative,
+        ``reach_share`` is not in (0, 1] or below 1 for one of pymoo's, or ``"agemoea"`` is asked for
+        without numba installed (pymoo's AGE-MOEA needs it: the ``agemoea`` extra).
 
     Examples
     --------
@@ -78,12 +132,14 @@ def make_algorithm(
     sampling = CommandSampling(sampling_weights, include=include)
     replan = {key: check_int(value, key, minimum=0) for key, value in
               (("replan_window", replan_window), ("replan_members", replan_members)) if value is not None}
+    if reach_share is not None:
+        replan["reach_share"] = check_real(reach_share, "reach_share", minimum=0.0, maximum=1.0, include_minimum=False)
     if name == "htetro-ga":
         return HTetroGA(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate, **replan)
     if name == "htetro-ga-paper":
         return HTetroGA.as_published(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate, **replan)
-    if replan.get("replan_window"):
-        raise ParameterError(f"replan_window applies to the hTetro-GA (htetro-ga, htetro-ga-paper), not to {name!r}")
+    if replan.get("reach_share", 1.0) < 1.0:
+        raise ParameterError(f"reach_share applies to the hTetro-GA (htetro-ga, htetro-ga-paper), not to {name!r}")
     operators = dict(
         sampling=sampling,
         crossover=CommandCrossover(prob=crossover_rate),
@@ -91,6 +147,14 @@ def make_algorithm(
         eliminate_duplicates=CommandDuplicateElimination(),
         repair=CommandRepair(),
     )
+    algorithm = _pymoo_algorithm(name, pop_size, operators)
+    window = replan.get("replan_window", _PYMOO_REPLAN[0])
+    if window:
+        algorithm.mating = ReplanMating(algorithm.mating, window, replan.get("replan_members", _PYMOO_REPLAN[1]))
+    return algorithm
+
+
+def _pymoo_algorithm(name: str, pop_size: int, operators: dict):
     if name == "nsga2":
         from pymoo.algorithms.moo.nsga2 import NSGA2
 

@@ -66,7 +66,7 @@ from htetro_opt.operators.commands import (
 from htetro_opt.operators.commands import as_column, sequences
 from htetro_opt.operators.commands.batch import apply_crossover, apply_mutation
 from htetro_opt.operators.commands.duplicates import chromosome_key, first_keys
-from htetro_opt.operators.commands.replan import CommandReplan
+from htetro_opt.operators.commands.replan import CommandReplan, replan_rows
 from htetro_opt.operators.commands.shortcut import repair_shortcut_evaluate
 
 __all__ = ["HTetroGA", "trim_reached"]
@@ -333,13 +333,7 @@ class HTetroGA(GeneticAlgorithm):
     def _replan_members(self, rng: np.random.Generator) -> np.ndarray:
         """Rows to re-plan: the fastest goal-reaching member (the first of equals) and
         ``replan_members`` others drawn without replacement among the reaching ones."""
-        reached = np.flatnonzero(self._members.reached)
-        if not len(reached):
-            return reached
-        best = reached[np.argmin(self._members.time[reached])]
-        others = reached[reached != best]
-        drawn = rng.choice(others, size=min(self.replan_members, len(others)), replace=False)
-        return np.r_[best, np.sort(drawn)].astype(np.int64)
+        return replan_rows(self._members.reached, self._members.time, self.replan_members, random_state=rng)
 
     def _merge(self, offspring: _Members) -> None:
         """The goal-reachability sort of the members and the (trimmed) offspring."""

@@ -29,7 +29,11 @@ on the first four maps of its Table 6). The options:
 
 - ``plan``: method ``dijkstra`` (alias ``exact``), ``astar``, ``htetro-ga``, ``htetro-ga-paper``,
   ``nsga2``, ``nsga3``, ``smsemoa``, ``agemoea``, ``heat``; ``clearance``; ``diagonals`` (the exact
-  methods); ``pop_size``, ``max_gen``, ``patience``, ``max_length`` (the GAs); ``weights``
+  methods); ``pop_size``, ``max_gen``, ``patience``, ``max_length``, ``convergence`` (``"best"`` or
+  ``"hypervolume"``), ``pick`` (``"balanced"``, ``"fastest"``, ``"smoothest"``, ``"safest"``),
+  ``seed_exact``, ``replan_window``, ``replan_members`` (the GAs; pymoo's algorithms re-plan only
+  when given a window), ``reach_share`` (the hTetro-GA's sort: ``htetro-ga`` and
+  ``htetro-ga-paper`` only; see :func:`~htetro_opt.solvers.grid_paths.plan_ga`); ``weights``
   (``[w_t, w_sm, w_sf]`` or ``"w_t,w_sm,w_sf"``), ``t_max``, ``element`` (``"q1"`` or ``"p0"``),
   ``monotone``, ``band`` (``"auto"``, ``"full"`` or a radius in cells) (the heat planner of
   Do et al. 2021, which always plans with the diagonals);
@@ -195,8 +199,12 @@ METRICS = {
 - ``fitness``: the GAs' ``f_gr``, ``f_t``, ``f_sm``, ``f_sf`` of the multi-objective solution,
   averaged over the legs (Cheng et al. 2020's Table 4);
 - ``gap``: ``reference`` (the exact optimum's time or cost) and ``gap`` = (value − reference) /
-  reference; for ``sequence`` only where the optimum is proven (≤ 40 waypoints); for ``cover``
-  the reference is the trial's ``lower_bound`` (a bound, not an optimum: its gap is an upper bound
+  reference; for the GA methods also ``fastest_time``, the summed time of each leg's fastest
+  goal-reaching front member (the plan's legs chain the picked member, ``pick``; with moving
+  obstacles a leg's fastest member is timed from the picked chain's clock, and a leg started later
+  can be quicker than Dijkstra's leg-by-leg optimal plan, so the sum may fall below the reference),
+  and ``fastest_gap``, its gap to the same reference; for ``sequence`` only where the optimum is
+  proven (≤ 40 waypoints); for ``cover`` the reference is the trial's ``lower_bound`` (a bound, not an optimum: its gap is an upper bound
   on the gap to the optimum);
 - ``heat_fitness`` (every plan method): Do et al. 2021's costs of the plan
   (:func:`~htetro_opt.problems.heat_costs.heat_fitness`, eqs. 9–12 with Fig. 5's safety), so that
@@ -225,7 +233,8 @@ RUNTIME_FIELDS = ("runtime_s", "reach_time_s")
 _METRIC_FIELDS = {
     "plan": ("reached", "time", "n_commands", "translations", "rotations", "shapeshifts", "path_length",
              "generations", "reach_generation", "reach_time_s", "f_gr", "f_t", "f_sm", "f_sf", "reference", "gap",
-             "heat_f_t", "heat_f_sm", "heat_f_sf", "heat_f", "shapes_used", "hv", "igd_plus"),
+             "heat_f_t", "heat_f_sm", "heat_f_sf", "heat_f", "shapes_used", "hv", "igd_plus", "fastest_time",
+             "fastest_gap"),
     "tile": ("tiles", "overlapping", "n_I", "n_O", "n_L", "n_J", "n_Z", "n_S", "n_T"),
     "sequence": ("cost", "waypoints", "optimal", "reference", "gap"),
     # the summary's columns; the records hold more (path_length, turns, memo_hits, nodes, …)
@@ -380,6 +389,28 @@ def _check_stripes(value, name: str) -> int | list[int]:
                              f"got {value!r}") from None
 
 
+def _check_choice(choices: Callable[[], Sequence[str]], what: str) -> Callable:
+    """A check of an option that names one of ``choices()`` (loaded when checked: pymoo stays lazy)."""
+    def check(value, name: str) -> str:
+        known = tuple(choices())
+        if not isinstance(value, str) or value not in known:
+            raise ParameterError(f"{name} must be one of {', '.join(known)} ({what}), got {value!r}")
+        return value
+    return check
+
+
+def _picks() -> tuple[str, ...]:
+    from htetro_opt.algorithms import PICKS
+
+    return tuple(PICKS)
+
+
+def _convergence_measures() -> tuple[str, ...]:
+    from htetro_opt.algorithms import CONVERGENCE_MEASURES
+
+    return tuple(CONVERGENCE_MEASURES)
+
+
 def _check_cover_start(value, name: str) -> str:
     if value not in ("scenario", "auto"):
         raise ParameterError(f"{name} must be 'scenario' (the roadmap's first and last poses) or 'auto' (the "
@@ -405,9 +436,10 @@ def _check_weights(value, name: str) -> list[float]:
 
 
 _ALL = None  # an option every method of the task takes
+_HTETRO_GA = ("htetro-ga", "htetro-ga-paper")  # the hTetro-GA's own sort: pymoo's algorithms have none
 _OPTIONS: dict[str, dict[str, tuple[Callable, str | None]]] = {
     # option: (check, which methods take it: None all, "exact" the graph searches, "heat" Do et al.
-    # 2021's planner, "ga" the others)
+    # 2021's planner, "ga" the others, or a tuple of kinds and method names)
     "plan": {
         "clearance": (_check_clearance, _ALL),
         "diagonals": (check_bool, "exact"),
@@ -415,6 +447,12 @@ _OPTIONS: dict[str, dict[str, tuple[Callable, str | None]]] = {
         "max_gen": (lambda v, n: check_int(v, n, minimum=1), "ga"),
         "patience": (lambda v, n: check_int(v, n, minimum=1), "ga"),
         "max_length": (lambda v, n: check_int(v, n, minimum=1), "ga"),
+        "convergence": (_check_choice(_convergence_measures, "the termination's measure of improvement"), "ga"),
+        "pick": (_check_choice(_picks, "the front member each leg returns"), "ga"),
+        "seed_exact": (check_bool, "ga"),
+        "replan_window": (lambda v, n: check_int(v, n, minimum=0), "ga"),
+        "replan_members": (lambda v, n: check_int(v, n, minimum=0), "ga"),
+        "reach_share": (lambda v, n: check_real(v, n, minimum=0.0, maximum=1.0, include_minimum=False), _HTETRO_GA),
         "weights": (_check_heat_weights, "heat"),
         "t_max": (lambda v, n: check_real(v, n, minimum=0.0, include_minimum=False), "heat"),
         "element": (_check_element, "heat"),
@@ -447,12 +485,14 @@ _REFERENCE_OPTIONS = {"plan": ("clearance", "diagonals"), "sequence": ("start", 
 
 
 _SCOPE_NAMES = {"exact": "the exact methods (dijkstra, astar)", "heat": "the heat planner (Do et al. 2021)",
-                "ga": "the GA methods", "stripes": "the stripes methods (stripes, stripes-paper)",
+                "ga": "the GA methods", _HTETRO_GA: "the hTetro-GA methods (htetro-ga, htetro-ga-paper)",
+                "stripes": "the stripes methods (stripes, stripes-paper)",
                 ("stripes", "tiling-tsp"): "the stripes methods (stripes, stripes-paper) and tiling-tsp"}
 
 
 def _takes(task: str, method: str, scope: str | tuple[str, ...] | None) -> bool:
-    return scope is None or _kind(task, method) in ((scope,) if isinstance(scope, str) else scope)
+    scopes = (scope,) if isinstance(scope, str) else scope
+    return scope is None or _kind(task, method) in scopes or method in scopes
 
 
 def _seeded(task: str, method: str, parameters: Mapping[str, Any]) -> bool:
@@ -1003,6 +1043,8 @@ def _plan(scenario, method, parameters, seed, metrics) -> tuple[dict, dict, floa
         out.update({k: objectives[k] if reached else None
                     for k in ("translations", "rotations", "shapeshifts", "path_length")})
     legs = plan.legs
+    if "gap" in metrics and _plan_kind(method) == "ga":  # fastest_gap, beside the picked plan's gap
+        out["fastest_time"] = sum(float(leg.selected["time"].time) for leg in legs) if reached else None
     if "generations" in metrics:
         out["generations"] = sum(leg.generations for leg in legs) if legs else None
         out["reach_generation"] = plan.reach_generation
@@ -1165,7 +1207,8 @@ def run_trial(task: str, scenario: str, method: str, parameters: Mapping[str, An
         A method of the task's command-line verb (``plan`` also takes ``exact`` for ``dijkstra``).
     parameters : mapping
         The verb's options, as a study's method entry gives them (``plan``: clearance, diagonals,
-        pop_size, max_gen, patience, max_length, and the heat planner's weights, t_max, element,
+        pop_size, max_gen, patience, max_length, convergence, pick, seed_exact, replan_window,
+        replan_members, reach_share, and the heat planner's weights, t_max, element,
         monotone, band; ``tile``: shapes, overlap, shuffle, time_limit; ``sequence``: start,
         weights, time_limit, shapes; ``cover``: shapes, start, clearance, stripes, region_columns,
         budget, time_limit).
@@ -1264,15 +1307,23 @@ def _with_gap(record: dict, reference: Mapping[str, Any] | None) -> dict:
     else:
         value = record.get("cost")
         best = reference.get("cost") if reference and reference.get("optimal") else None
-    gap = None
-    if value is not None and best is not None:
-        gap = (value - best) / best if best > 0 else (0.0 if value == best else None)
+    gaps = {"gap": _relative_gap(value, best)}
+    if "fastest_time" in record:
+        gaps["fastest_gap"] = _relative_gap(record["fastest_time"], best)
     out = {}
     for k, v in record.items():
         if k == "runtime_s":
-            out["reference"], out["gap"] = best, _finite(gap)
+            out["reference"] = best
+            out.update(gaps)
         out[k] = v
     return out
+
+
+def _relative_gap(value, best) -> float | None:
+    """(value − best) / best; None where either is missing (or best is 0 and value is not)."""
+    if value is None or best is None:
+        return None
+    return _finite((value - best) / best if best > 0 else (0.0 if value == best else None))
 
 
 # --- executors -------------------------------------------------------------------------------------

@@ -67,3 +67,74 @@ def test_agemoea_without_numba_is_a_clear_error(monkeypatch):
     monkeypatch.setitem(sys.modules, "numba", None)  # makes `import numba` fail
     with pytest.raises(ParameterError, match="numba"):
         make_algorithm("agemoea", 12)
+
+
+@pytest.mark.parametrize("name", ["htetro-ga", "htetro-ga-paper"])
+def test_reach_share_reaches_the_htetro_ga_sort(name):
+    assert make_algorithm(name, 20).survival.reach_share == 1.0
+    assert make_algorithm(name, 20, reach_share=0.6).survival.reach_share == 0.6
+
+
+@pytest.mark.parametrize("share, name, word", [(0.0, "htetro-ga", "reach_share"), (1.1, "htetro-ga-paper", "reach_share"),
+                                               (0.75, "nsga2", "applies to the hTetro-GA")])
+def test_reach_share_is_refused_out_of_range_or_for_pymoo_algorithms(share, name, word):
+    with pytest.raises(ParameterError, match=word):
+        make_algorithm(name, 20, reach_share=share)
+
+
+def test_plan_ga_passes_reach_share_on():
+    from htetro_opt.solvers.grid_paths import plan_ga
+
+    ws, roadmap = Workspace(np.zeros((10, 10), dtype=bool)), [Pose(2, 2, "O", 0), Pose(6, 5, "O", 0)]
+    plans = [plan_ga(ws, roadmap, pop_size=20, max_gen=30, max_length=20, seed=3, reach_share=s) for s in (None, 0.5)]
+    assert all(p.reached for p in plans) and plans[0].legs[0].front != plans[1].legs[0].front
+    assert make_algorithm("nsga2", 20, reach_share=1.0).pop_size == 20  # 1 is no cap: any algorithm takes it
+    with pytest.raises(ParameterError, match="reach_share"):
+        plan_ga(ws, roadmap, algorithm="nsga2", reach_share=0.5)
+
+
+# --- the re-planning step for pymoo's algorithms ---------------------------------------------------
+PYMOO = [name for name in GA_ALGORITHMS if not name.startswith("htetro")]
+
+
+@pytest.mark.parametrize("name", PYMOO)
+def test_pymoo_algorithms_take_the_replanning_through_their_mating(name):
+    from pymoo.core.mating import Mating
+
+    from htetro_opt.algorithms.factory import ReplanMating
+
+    if name == "agemoea":
+        pytest.importorskip("numba")
+    plain, replanning = make_algorithm(name, 12), make_algorithm(name, 12, replan_window=9, replan_members=2)
+    assert type(plain.mating) is Mating and not isinstance(plain.mating, ReplanMating)
+    assert isinstance(replanning.mating, ReplanMating) and replanning.mating.mating.selection is not None
+    assert (replanning.mating.replan.window, replanning.mating.members) == (9, 2)
+    assert make_algorithm(name, 12, replan_window=5).mating.members == 3
+    assert type(make_algorithm(name, 12, replan_window=0).mating) is Mating
+
+
+def test_replan_mating_adds_the_fastest_members_exact_window_to_the_offspring():
+    from pymoo.core.population import Population
+
+    from htetro_opt.model import format_commands, parse_commands
+    from htetro_opt.solvers.grid_paths import plan_exact
+
+    ws = Workspace(np.zeros((8, 8), dtype=bool))
+    start, goal = Pose(1, 2, "O", 0), Pose(5, 2, "O", 0)
+    problem = CommandPathProblem(ws, start, goal, max_length=10)
+    detour = parse_commands("y+,x+,x+,y-,x+,x+")  # reaches the goal in 6 s; the optimum takes 4
+    wander = parse_commands("y+,y+,x+")  # does not reach it
+    X = as_column([detour, wander])
+    pop = Population.new(X=X, F=problem.evaluate(X), rank=np.array([0, 1]), crowding=np.array([np.inf, np.inf]))
+    algorithm = make_algorithm("nsga2", 2, replan_window=6, replan_members=0)
+    off = algorithm.mating.do(problem, pop, 2, random_state=np.random.default_rng(0), algorithm=algorithm)
+    oracle = plan_exact(ws, [start, goal])
+    offspring = [format_commands(x) for x in sequences(off.get("X"))]
+    assert format_commands(oracle.commands) in offspring and len(off) <= 3
+
+
+def test_nsga2_with_the_replanning_reaches_and_stays_valid(small_problem):
+    res = minimize(small_problem, make_algorithm("nsga2", 12, replan_window=8), ("n_gen", 15), seed=2)
+    X = sequences(res.pop.get("X"))
+    assert len(res.pop) == 12 and np.array_equal(small_problem.evaluate(as_column(X)), res.pop.get("F"))
+    assert (res.pop.get("F")[:, 0] == -1).any()

@@ -183,9 +183,9 @@ def test_replan_parameters(options):
         make_algorithm("htetro-ga", 10, **{k: v for k, v in options.items() if v is not None} or dict(replan_window=-1))
 
 
-def test_pymoos_algorithms_refuse_a_replan_window():
+def test_pymoos_algorithms_refuse_a_negative_replan_window():
     with pytest.raises(ParameterError, match="replan_window"):
-        make_algorithm("nsga2", 10, replan_window=5)
+        make_algorithm("nsga2", 10, replan_window=-5)
     assert type(make_algorithm("nsga2", 10, replan_window=0)).__name__ == "NSGA2"
 
 

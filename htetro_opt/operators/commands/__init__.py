@@ -24,7 +24,7 @@ from htetro_opt.operators.commands.mutation import CommandMutation, mutate_comma
 from htetro_opt.operators.commands.rearrangement import CommandRearrangement, rearrange_commands
 from htetro_opt.operators.commands.repair import CommandRepair
 from htetro_opt.operators.commands.removal import CommandRemoval, remove_commands
-from htetro_opt.operators.commands.replan import CommandReplan, TransitionGraph, replan_windows
+from htetro_opt.operators.commands.replan import CommandReplan, TransitionGraph, replan_rows, replan_windows
 from htetro_opt.operators.commands.shortcut import (
     CommandShortcut,
     cut_longest_loop,
@@ -45,7 +45,7 @@ __all__ = [
     "CommandRemoval", "remove_commands",
     "CommandRepair",
     "CommandShortcut", "cut_longest_loop", "longest_loops", "shortcut_sequences", "repair_and_shortcut",
-    "CommandReplan", "TransitionGraph", "replan_windows",
+    "CommandReplan", "TransitionGraph", "replan_rows", "replan_windows",
     "DEFAULT_SAMPLING_WEIGHTS", "CommandSampling", "sample_commands",
     "RankAndCrowdingTournament", "rank_and_crowding_tournament",
     "GoalReachabilitySurvival", "reaches_goal",

@@ -22,7 +22,7 @@ from htetro_opt.errors import PlanningError
 from htetro_opt.model.simulate import Simulator
 from htetro_opt.operators.commands._chromosome import as_column, sequences
 
-__all__ = ["CommandReplan", "TransitionGraph", "replan_windows"]
+__all__ = ["CommandReplan", "TransitionGraph", "replan_rows", "replan_windows"]
 
 _TOLERANCE = 1e-9  # times are sums of float durations: an equal time is not an improvement
 _ANSWERS = 1 << 14  # searches :meth:`TransitionGraph.fastest` remembers (a few hundred bytes each)
@@ -263,6 +263,35 @@ def replan_windows(problem, seqs: list[np.ndarray], *, window: int, random_state
     if timed and graph.period > 1 and unsettled:
         improve(unsettled, static=False)
     return out
+
+
+def replan_rows(reached, time, members: int, *, random_state: np.random.Generator) -> np.ndarray:
+    """The rows a generation re-plans: the fastest goal-reaching one (the first of equals) and
+    ``members`` others drawn without replacement among the reaching ones, those in row order.
+
+    Parameters
+    ----------
+    reached : array-like of bool
+        Which rows reach the goal.
+    time : array-like of float
+        A time per row (or any key smaller for faster, e.g. pymoo's F column of −f_t).
+    members : int
+        K, the reaching rows drawn besides the fastest.
+    random_state : numpy.random.Generator, keyword-only
+
+    Examples
+    --------
+    >>> replan_rows([True, False, True, True], [9.0, 1.0, 5.0, 7.0], 1, random_state=np.random.default_rng(0))
+    array([2, 3])
+    """
+    members = check_int(members, "replan members", minimum=0)
+    reached = np.flatnonzero(np.asarray(reached, dtype=bool))
+    if not len(reached):
+        return reached.astype(np.int64)
+    best = reached[np.argmin(np.asarray(time, dtype=float)[reached])]
+    others = reached[reached != best]
+    drawn = random_state.choice(others, size=min(members, len(others)), replace=False)
+    return np.r_[best, np.sort(drawn)].astype(np.int64)
 
 
 class CommandReplan(Mutation):

@@ -144,6 +144,7 @@ def plan_ga(
     replan_members: int | None = None,
     seed_exact: bool = False,
     pick: str = "balanced",
+    reach_share: float | None = None,
 ) -> Plan:
     """Plan through a roadmap with a command-chromosome GA, one optimisation per leg.
 
@@ -198,7 +199,8 @@ def plan_ga(
         ``replan_members`` random reaching ones is replaced by the minimum-time path between its end
         poses (ours; :class:`~htetro_opt.operators.commands.CommandReplan`). None: the algorithm's
         default, W = 40 and 3 members for ``"htetro-ga"``, off for ``"htetro-ga-paper"``; 0 turns it
-        off. pymoo's algorithms refuse a window other than 0.
+        off. pymoo's algorithms take the same step after their own mating when given a window
+        (:class:`~htetro_opt.algorithms.ReplanMating`; off by default, K = 3 unless given).
     seed_exact : bool, keyword-only
         Put each leg's exact minimum-time plan (:func:`~htetro_opt.solvers.grid_paths.plan_exact`,
         from the leg's start at its time) into the leg's initial population, so that the GA spends its
@@ -210,6 +212,11 @@ def plan_ga(
         with the largest sum of the four fitnesses (the paper's multi-objective based solution; the
         paper also says "the smallest crowding distance", see :data:`~htetro_opt.algorithms.PICKS`),
         or the best f_t, f_sm or f_sf.
+    reach_share : float, optional, keyword-only
+        The hTetro-GA's cap on the goal-reaching section of its sort, a share in (0, 1] of n_pop
+        (ours; :class:`~htetro_opt.algorithms.HTetroGA`). None: 1, no cap, the paper's sort (measured
+        in benchmarks/README.md: 0.75 changes little once the re-planning is on). pymoo's algorithms
+        refuse a share below 1.
 
     Returns
     -------
@@ -236,7 +243,8 @@ def plan_ga(
     >>> plan.reached, plan.time
     (True, 7.0)
     """
-    make_algorithm(algorithm, pop_size, replan_window=replan_window, replan_members=replan_members)  # validates
+    make_algorithm(algorithm, pop_size, replan_window=replan_window, replan_members=replan_members,
+                   reach_share=reach_share)  # validates
     seed_exact = check_bool(seed_exact, "seed_exact")
     if not isinstance(pick, str) or pick not in PICKS:
         raise ParameterError(f"pick must be one of {', '.join(PICKS)}, got {pick!r}")
@@ -274,7 +282,7 @@ def plan_ga(
         termination = FrontConvergence(max_gen=max_gen, patience=patience, measure=convergence)
         res = minimize(problem, make_algorithm(algorithm, pop_size, sampling_weights=sampling_weights,
                                                replan_window=replan_window, replan_members=replan_members,
-                                               include=include),
+                                               reach_share=reach_share, include=include),
                        termination, seed=int(leg_seeds[leg]), callback=recorder, verbose=verbose)
         X, F = res.pop.get("X"), res.pop.get("F")
         chosen = select_solutions(F)

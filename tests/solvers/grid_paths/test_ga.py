@@ -171,7 +171,8 @@ def test_pick_returns_the_member_with_the_largest_fitness(pick, column):
 def test_pick_seed_exact_and_replan_errors():
     roadmap = [START, GOAL]
     for options in (dict(pick="best"), dict(pick=None), dict(seed_exact="yes"), dict(replan_window=-1),
-                    dict(replan_members=-1), dict(algorithm="nsga2", replan_window=4)):
+                    dict(replan_members=-1), dict(algorithm="nsga2", replan_window=-4),
+                    dict(algorithm="smsemoa", reach_share=0.5)):
         with pytest.raises(ParameterError):
             plan_ga(OPEN, roadmap, max_gen=2, **options)
 
@@ -211,7 +212,7 @@ def test_cli_ga_flags(capsys):
     (["--method", "htetro-ga", "--replan-members", "-1"], "--replan-members"),
     (["--method", "htetro-ga", "--replan-window", "x"], "--replan-window"),
     (["--method", "htetro-ga", "--pick", "best"], "--pick"),
-    (["--method", "nsga2", "--replan-window", "5"], "replan_window"),
+    (["--method", "nsga2", "--replan-window", "-5"], "--replan-window"),
     (["--method", "dijkstra", "--seed-exact"], "--seed-exact"),
     (["--method", "astar", "--pick", "fastest"], "--pick"),
     (["--method", "heat", "--replan-window", "5"], "--replan-window"),
