@@ -23,6 +23,7 @@ PAPERS = {
     "00_quickstart.ipynb": "Cheng et al. 2020",
     "01_htetro_ga_pareto.ipynb": "Cheng et al. 2020",
     "02_heat_conduction.ipynb": "Do et al. 2021",
+    "03_enhanced_ga.ipynb": "Nazarahari et al. 2019",
     "04_tiling_sequencing.ipynb": "Le et al. 2018",
     "05_stripe_coverage.ipynb": "Cheng et al. 2019",
 }

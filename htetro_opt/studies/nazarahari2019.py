@@ -3,13 +3,18 @@ PRM, B-RRT, PSO, EGA linear, EGA spline, and our EGA-paper, × seeds), §5.1's f
 §5.3's normalised weights on map 4, and the four robots of ``ega_cross4`` (our Fig. 11), every
 length beside the exact optimum (the visibility graph: r = 0 on these maps).
 
-Run in this process, not on the study runner: the runner's tasks plan grid scenarios, and each trial
-here needs its map's exact optimum, computed once per map (0.01–0.1 s) and shared by every method
-and seed; a trial takes 0.01–1.5 s, so a default run (5 seeds) takes a few minutes on one core.
+Not on the study runner: the runner's tasks plan grid scenarios, and each trial here needs its map's
+exact optimum, computed once per map (0.01–0.1 s) in this process and shared by every method and
+seed. The trials run on worker processes (``jobs``, default the local cores). A seed costs about
+90 s of trials on one core (EGA spline about 80 s of it, 0.5–15 s a map; every other Table 2 row
+0.01–1.5 s); §5.1's five pairs cost 45 s a seed, so by default they run on the first seed only
+(``pair_seeds``; ``--pair-seeds N``, ``--no-pairs``). The default run (5 seeds, pairs on one; what
+``htetro-opt study nazarahari2019`` runs) took 5.4 minutes on 2 cores shared with other work
+(benchmarks/results/nazarahari2019).
 
-``python -m htetro_opt.studies.nazarahari2019 [--seeds N] [--out DIR] [--rrt-time-limit S]``
-(``htetro-opt study nazarahari2019`` does the same) prints the report; ``--out`` writes
-DIR/nazarahari2019.md and DIR/nazarahari2019.csv.
+``python -m htetro_opt.studies.nazarahari2019 [--seeds N] [--out DIR] [--rrt-time-limit S] [--pair-seeds N]
+[--no-pairs] [--jobs N]`` (``htetro-opt study nazarahari2019`` runs the defaults) prints the report;
+``--out`` writes DIR/nazarahari2019.md and DIR/nazarahari2019.csv.
 """
 
 from __future__ import annotations
@@ -17,7 +22,9 @@ from __future__ import annotations
 import argparse
 import csv
 import io
+import os
 import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -186,8 +193,26 @@ def _record(plan, **keys) -> dict:
             "smoothness": float(np.nansum(plan.smoothness_deg)), "runtime": float(plan.runtime_s)}
 
 
-def run_nazarahari2019(seeds=5, *, maps=MAPS, methods=tuple(METHODS), pairs=PAIRS, rrt_time_limit=None,
-                       progress=None) -> Run:
+def _trial(part: str, name: str, label: str, method: str, options: dict, seed, seeded: bool = True) -> dict:
+    """One trial, a pure function of its arguments (run in a worker process or in this one)."""
+    scenario = load_scenario(name)
+    plan = plan_continuous(scenario, method=method, **options, **({"seed": seed} if seeded else {}))
+    if part == "table2":
+        return _record(plan, map=name, method=label, seed=seed)
+    if part == "pairs":
+        return _record(plan, map=name, pair=label, seed=seed)
+    if part == "normalised":
+        w = plan.info["weights"]
+        terms = (float(plan.lengths[0]), w[1] * float(plan.smoothness_deg[0]),
+                 w[2] / max(float(plan.safety[0]), 1e-12))
+        return {"seed": seed, "weights": list(w), "terms": list(terms), "single": plan.info["normalised_from"],
+                "runtime": float(plan.runtime_s)}
+    return {**_record(plan, map=name, method=label, seed=seed), "min_robot_distance": plan.min_robot_distance,
+            "safety_distance": plan.safety_distance, "conflicts": len(plan.conflicts)}
+
+
+def run_nazarahari2019(seeds=5, *, maps=MAPS, methods=tuple(METHODS), pairs=PAIRS, pair_seeds=1,
+                       rrt_time_limit=None, normalised=True, cross4=True, jobs=None, progress=None) -> Run:
     """Run the study (see the module docstring).
 
     Parameters
@@ -198,59 +223,59 @@ def run_nazarahari2019(seeds=5, *, maps=MAPS, methods=tuple(METHODS), pairs=PAIR
         Subsets of :data:`MAPS` and :data:`METHODS`' labels.
     pairs : keyword-only
         §5.1's (IS, PS) pairs to run with EGA linear (empty: skip).
+    pair_seeds : int, keyword-only
+        How many of the seeds (the first) run the pairs: 1 by default, since the pairs cost a third
+        of a seed's trials and the EGA's spread between seeds is small; ``None``: every seed.
     rrt_time_limit : float, keyword-only
         B-RRT's seconds per run (default 120, the paper's).
+    normalised, cross4 : bool, keyword-only
+        Run §5.3's normalised weights (when map 4 is among ``maps``) and the four robots (default: both).
+    jobs : int, keyword-only
+        Worker processes (default: the local cores; 1: this process). Every trial is a pure function
+        of its map, method, options and seed, so the records are the same whatever ``jobs`` is, but
+        for the runtimes.
     progress : callable, optional
         Called with the number of trials done after each.
     """
     seeds = list(range(check_int(seeds, "seeds", minimum=1))) if not isinstance(seeds, (list, tuple)) else list(seeds)
+    pair_seeds = seeds if pair_seeds is None else seeds[:check_int(pair_seeds, "pair_seeds", minimum=0)]
     rrt_time_limit = check_time_limit(rrt_time_limit, "rrt_time_limit")
+    jobs = check_int(os.cpu_count() or 1 if jobs is None else jobs, "jobs", minimum=1)
     began = time.perf_counter()
     run = Run(seeds=seeds)
-    done = 0
-
-    def tick():
-        nonlocal done
-        done += 1
-        if progress is not None:
-            progress(done)
-
+    tasks = []  # _trial's arguments
     for name in maps:
-        scenario = load_scenario(name)
-        run.exact[name] = float(plan_continuous(scenario).length)
+        run.exact[name] = float(plan_continuous(load_scenario(name)).length)
         for label in methods:
             method, options = METHODS[label]
             if method == "rrt" and rrt_time_limit is not None:
                 options = {**options, "time_limit": rrt_time_limit}
             for seed in seeds[:1] if label in DETERMINISTIC else seeds:
-                extra = {} if label in DETERMINISTIC else {"seed": seed}
-                plan = plan_continuous(scenario, method=method, **options, **extra)
-                run.table2.append(_record(plan, map=name, method=label, seed=seed))
-                tick()
+                tasks.append(("table2", name, label, method, options, seed, label not in DETERMINISTIC))
         for max_gen, pop_size in pairs:
-            for seed in seeds:
-                plan = plan_continuous(scenario, method="ega", pop_size=pop_size, max_gen=max_gen, seed=seed)
-                run.pairs.append(_record(plan, map=name, pair=f"({max_gen}, {pop_size})", seed=seed))
-                tick()
-    if "ega04_corridor1" in maps:
-        scenario = load_scenario("ega04_corridor1")
-        for seed in seeds:
-            plan = plan_continuous(scenario, method="ega", normalise=True, seed=seed)
-            w = plan.info["weights"]
-            terms = (float(plan.lengths[0]), w[1] * float(plan.smoothness_deg[0]),
-                     w[2] / max(float(plan.safety[0]), 1e-12))
-            run.normalised.append({"seed": seed, "weights": list(w), "terms": list(terms),
-                                   "single": plan.info["normalised_from"], "runtime": float(plan.runtime_s)})
-            tick()
-    scenario = load_scenario("ega_cross4")
-    own = float(plan_continuous(scenario).length)
-    run.exact["ega_cross4"] = own
-    for seed in seeds:
-        plan = plan_continuous(scenario, method="ega", seed=seed)
-        run.cross4.append({**_record(plan, map="ega_cross4", method="EGA linear", seed=seed),
-                           "min_robot_distance": plan.min_robot_distance, "safety_distance": plan.safety_distance,
-                           "conflicts": len(plan.conflicts)})
-        tick()
+            for seed in pair_seeds:
+                tasks.append(("pairs", name, f"({max_gen}, {pop_size})", "ega",
+                              {"pop_size": pop_size, "max_gen": max_gen}, seed))
+    if normalised and "ega04_corridor1" in maps:
+        tasks += [("normalised", "ega04_corridor1", "EGA linear", "ega", {"normalise": True}, seed) for seed in seeds]
+    if cross4:
+        run.exact["ega_cross4"] = float(plan_continuous(load_scenario("ega_cross4")).length)
+        tasks += [("cross4", "ega_cross4", "EGA linear", "ega", {}, seed) for seed in seeds]
+    records = [None] * len(tasks)
+    if jobs == 1 or len(tasks) <= 1:
+        for k, task in enumerate(tasks):
+            records[k] = _trial(*task)
+            if progress is not None:
+                progress(k + 1)
+    else:
+        with ProcessPoolExecutor(max_workers=min(jobs, len(tasks))) as pool:
+            futures = {pool.submit(_trial, *task): k for k, task in enumerate(tasks)}
+            for done, future in enumerate(as_completed(futures), 1):
+                records[futures[future]] = future.result()
+                if progress is not None:
+                    progress(done)
+    for task, record in zip(tasks, records):
+        getattr(run, task[0]).append(record)
     run.seconds = time.perf_counter() - began
     return run
 
@@ -313,7 +338,9 @@ def report(run: Run) -> str:
                 w(f"- {label} shorter than A* 0.25 on {len(wins)} of {len(astar)} maps (paper, EGA: 7 of 12)\n")
         w("\n")
     if run.pairs:
-        w("## §5.1: (IS, PS) pairs, EGA linear (mean length / the pair's best mean on the map)\n\n")
+        n = len({r["seed"] for r in run.pairs})
+        w(f"## §5.1: (IS, PS) pairs, EGA linear, {n} seed{'s' if n > 1 else ''} (mean length / the pair's best "
+          "mean on the map; mean runtime)\n\n")
         labels = [f"({i}, {p})" for i, p in PAIRS]
         w("| map | " + " | ".join(labels) + " | paper (100, 20) |\n|---|" + "---|" * (len(labels) + 1) + "\n")
         for k, name in enumerate(m for m in MAPS if m in run.exact):
@@ -374,15 +401,19 @@ def write_report(folder, run: Run) -> tuple[Path, Path]:
 
 
 def main(argv=None) -> int:
-    """``python -m htetro_opt.studies.nazarahari2019 [--seeds N] [--out DIR] [--rrt-time-limit S] [--no-pairs]``."""
+    """``python -m htetro_opt.studies.nazarahari2019 [--seeds N] [--out DIR] [--rrt-time-limit S] [--pair-seeds N]
+    [--no-pairs] [--jobs N]``."""
     parser = argparse.ArgumentParser(prog="python -m htetro_opt.studies.nazarahari2019",
                                      description="Nazarahari et al. 2019's Table 2, §5.1, §5.3 and four robots")
     parser.add_argument("--seeds", type=int, default=5, help="seeds 0 … N−1 (default 5; the paper: 50)")
     parser.add_argument("--out", help="write DIR/nazarahari2019.md and .csv")
     parser.add_argument("--rrt-time-limit", type=float, help="B-RRT seconds per run (default 120)")
+    parser.add_argument("--pair-seeds", type=int, default=1, help="run §5.1's pairs on the first N seeds (default 1)")
     parser.add_argument("--no-pairs", action="store_true", help="skip §5.1's (IS, PS) pairs")
+    parser.add_argument("--jobs", type=int, help="worker processes (default: the local cores; 1: this process)")
     args = parser.parse_args(argv)
-    run = run_nazarahari2019(args.seeds, rrt_time_limit=args.rrt_time_limit, pairs=() if args.no_pairs else PAIRS)
+    run = run_nazarahari2019(args.seeds, rrt_time_limit=args.rrt_time_limit, pairs=() if args.no_pairs else PAIRS,
+                             pair_seeds=args.pair_seeds, jobs=args.jobs)
     print(report(run), end="")
     if args.out:
         write_report(args.out, run)

@@ -44,3 +44,19 @@ def test_the_papers_fifty_seeds():
     ega = [r for r in run.table2 if r["method"] == "EGA linear"]
     assert all(r["reached"] for r in ega)
     assert all(r["length"] <= 1.005 * run.exact[r["map"]] for r in ega)
+
+
+def test_worker_processes_give_the_same_records_and_the_pairs_run_on_the_first_seeds():
+    options = {"maps": ("ega04_corridor1",), "methods": ("A* 1", "EGA-paper"), "pairs": ((20, 10),),
+               "pair_seeds": 1, "normalised": False, "cross4": False}
+    here = study.run_nazarahari2019(2, jobs=1, **options)
+    pool = study.run_nazarahari2019(2, jobs=2, **options)
+
+    def strip(records):
+        return [{k: v for k, v in r.items() if k != "runtime"} for r in records]
+
+    assert strip(here.table2) == strip(pool.table2) and strip(here.pairs) == strip(pool.pairs)
+    assert [(r["method"], r["seed"]) for r in here.table2] == [("A* 1", 0), ("EGA-paper", 0), ("EGA-paper", 1)]
+    assert [r["seed"] for r in here.pairs] == [0]
+    assert not here.normalised and not here.cross4 and "ega_cross4" not in here.exact
+    assert "§5.1: (IS, PS) pairs, EGA linear, 1 seed " in study.report(here)
