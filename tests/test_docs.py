@@ -385,8 +385,10 @@ def test_the_sequence_methods_add_the_fields_listed(examples):
         methods, extras = line.split(":", 1)
         for method in ticked(methods):
             listed[method] = set(ticked(extras))
-    assert set(listed) == {"ortools", "local", "ga", "ga-plain", "zigzag", "zigzag2", "spiral", "spiral2", "greedy"}
+    assert set(listed) == {"ortools", "local", "ga", "ga-plain", "zigzag", "zigzag2", "spiral", "spiral2", "greedy",
+                           "ils", "fast-tsp", "lkh"}
     instance = SequencingInstance.from_tileset(load_tileset(examples / "tiles.txt"), start=1)
     for method in sorted(listed):
-        result = sequence_waypoints(instance, method=method, seed=0, time_limit=0.2)
+        budget = {} if method == "lkh" else {"time_limit": 0.2}  # LKH counts runs, not seconds
+        result = sequence_waypoints(instance, method=method, seed=0, **budget)
         assert set(result.info) == listed[method], method

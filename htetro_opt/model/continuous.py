@@ -211,26 +211,7 @@ def robot_distance(path_a, path_b) -> float:
     >>> robot_distance([[0, 0], [2, 0]], [[2, 0], [2, 0]])       # b waits where a ends
     0.0
     """
-    a, b = _as_points(path_a, "path_a"), _as_points(path_b, "path_b")
-    if not len(a) or not len(b):
-        raise ParameterError("robot_distance needs two non-empty paths")
-    (a, sa), (b, sb) = _arclength(a), _arclength(b)
-    times = np.union1d(sa, sb)
-
-    def at(path, s, t):
-        if len(path) == 1:
-            return np.repeat(path, len(t), axis=0)
-        return np.column_stack([np.interp(t, s, path[:, 0]), np.interp(t, s, path[:, 1])])
-
-    rel = at(a, sa, times) - at(b, sb, times)
-    if len(rel) == 1:
-        return float(np.hypot(*rel[0]))
-    p, q = rel[:-1], rel[1:]
-    d = q - p
-    dd = (d * d).sum(axis=1)
-    u = np.clip(-(p * d).sum(axis=1) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
-    closest = p + u[:, None] * d
-    return float(np.hypot(closest[:, 0], closest[:, 1]).min())
+    return closest_approach(path_a, path_b)[0]
 
 
 def closest_approach(path_a, path_b) -> tuple[float, float]:
@@ -244,7 +225,7 @@ def closest_approach(path_a, path_b) -> tuple[float, float]:
     """
     a, b = _as_points(path_a, "path_a"), _as_points(path_b, "path_b")
     if not len(a) or not len(b):
-        raise ParameterError("closest_approach needs two non-empty paths")
+        raise ParameterError("the distance between two robots needs two non-empty paths")
     (a, sa), (b, sb) = _arclength(a), _arclength(b)
     times = np.union1d(sa, sb)
     rel = np.column_stack([np.interp(times, sa, a[:, 0]) if len(a) > 1 else np.full(len(times), a[0, 0]),

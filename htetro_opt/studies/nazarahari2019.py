@@ -149,6 +149,11 @@ _T2 = """
 """
 
 
+def _signed(value: float) -> str:
+    """A signed percentage to 2 decimals, without the "−0.00" of rounding noise below zero."""
+    return f"{round(float(value), 2) + 0.0:+.2f}"
+
+
 def _parse_table2(text: str) -> dict:
     table = {}
     for line in text.strip().splitlines():
@@ -317,7 +322,7 @@ def report(run: Run) -> str:
             gap = (np.mean(lengths) / exact - 1) * 100 if ok else float("nan")
             success = 100 * len(ok) / len(rows)
             paper = PAPER_TABLE2.get(name, {}).get(label)
-            w(f"| {label} | {_ms(lengths)} | {gap:+.2f} | {_ms([r['smoothness'] for r in ok], 1)} | "
+            w(f"| {label} | {_ms(lengths)} | {_signed(gap)} | {_ms([r['smoothness'] for r in ok], 1)} | "
               f"{_ms([r['runtime'] for r in rows], 3)} | {success:.0f} | {_paper_cell(paper, 0)} | "
               f"{_paper_cell(paper, 2, 1)} | {_paper_cell(paper, 4)} | "
               f"{'—' if paper is None else f'{paper[6]:.0f}'} |\n")
@@ -329,7 +334,7 @@ def report(run: Run) -> str:
             gaps = [g for (_, lab, _, g, _) in summary if lab == label]
             succ = [s for (_, lab, _, _, s) in summary if lab == label]
             if gaps:
-                w(f"- {label}: mean gap {np.nanmean(gaps):+.2f} % (max {np.nanmax(gaps):+.2f} %), success "
+                w(f"- {label}: mean gap {_signed(np.nanmean(gaps))} % (max {_signed(np.nanmax(gaps))} %), success "
                   f"{np.mean(succ):.0f} % over {len(gaps)} maps\n")
         astar = {n: length for (n, lab, length, _, _) in summary if lab == "A* 0.25"}
         for label in ("EGA linear", "EGA-paper", "PSO"):

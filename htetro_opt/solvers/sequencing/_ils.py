@@ -446,8 +446,9 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
         tours = np.array([(0, *p) for p in permutations(range(1, m))], dtype=np.int64).reshape(-1, m)
         costs = D[tours, np.roll(tours, -1, axis=1)].sum(axis=1)
         best = tours[int(np.argmin(costs))]
-        return _decode(best, dummy, instance), {"engine": "enumeration", "kicks": 0, "improving_kicks": 0,
-                                                "timed_out": False}
+        cost = float(costs.min())
+        return _decode(best, dummy, instance), {"engine": "enumeration", "initial_cost": cost, "kicks": 0,
+                                                "improving_kicks": 0, "timed_out": False, "tour_cost": cost}
     nbr = _neighbour_lists(D, neighbours)
     tour = _greedy_tour(D).astype(np.int64)
     info = {"engine": "numba", "initial_cost": float(_tour_cost(D, tour))}
