@@ -48,6 +48,7 @@ from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.population import Population
 
 from htetro_opt._validation import check_bool, check_int, check_probability, check_real
+from htetro_opt.algorithms.factory import _pymoo_algorithm
 from htetro_opt.errors import ParameterError
 from htetro_opt.operators.path_bases import (
     CollisionRemoval,
@@ -295,28 +296,4 @@ def make_path_algorithm(name: str = "ega", pop_size: int = 10, *, sampling=None)
     sampling = sampling if sampling is not None else PathBasesSampling()
     operators = dict(sampling=sampling, crossover=PathBasesCrossover(), mutation=PathBasesMutation(),
                      eliminate_duplicates=PathBasesDuplicateElimination(), repair=PathBasesDeletion())
-    if name == "nsga2":
-        from pymoo.algorithms.moo.nsga2 import NSGA2
-
-        return NSGA2(pop_size=pop_size, **operators)
-    if name == "nsga3":
-        from pymoo.algorithms.moo.nsga3 import NSGA3
-        from pymoo.util.ref_dirs import get_reference_directions
-
-        partitions = 1
-        while math.comb(partitions + 2, 2) <= pop_size:
-            partitions += 1
-        ref_dirs = get_reference_directions("das-dennis", 3, n_partitions=max(1, partitions - 1))
-        return NSGA3(ref_dirs=ref_dirs, pop_size=pop_size, **operators)
-    if name == "smsemoa":
-        from pymoo.algorithms.moo.sms import SMSEMOA
-
-        return SMSEMOA(pop_size=pop_size, **operators)
-    try:
-        from pymoo.algorithms.moo.age import AGEMOEA
-    except Exception as err:  # pymoo's AGE-MOEA module turns a missing numba into a bare Exception
-        raise ParameterError(
-            f"algorithm 'agemoea' needs numba, which pymoo's AGE-MOEA imports: "
-            f"pip install 'htetro-opt[agemoea]' ({err})"
-        ) from err
-    return AGEMOEA(pop_size=pop_size, **operators)
+    return _pymoo_algorithm(name, pop_size, operators, n_objectives=3)

@@ -154,7 +154,9 @@ def make_algorithm(
     return algorithm
 
 
-def _pymoo_algorithm(name: str, pop_size: int, operators: dict):
+def _pymoo_algorithm(name: str, pop_size: int, operators: dict, *, n_objectives: int = 4):
+    """pymoo's ``name`` (nsga2, nsga3, smsemoa, agemoea) over the given operators; NSGA-III's Das–Dennis
+    directions are the most, for ``n_objectives``, that ``pop_size`` holds (at least one partition)."""
     if name == "nsga2":
         from pymoo.algorithms.moo.nsga2 import NSGA2
 
@@ -164,9 +166,9 @@ def _pymoo_algorithm(name: str, pop_size: int, operators: dict):
         from pymoo.util.ref_dirs import get_reference_directions
 
         partitions = 1
-        while _n_directions(4, partitions + 1) <= pop_size:
+        while _n_directions(n_objectives, partitions + 1) <= pop_size:
             partitions += 1
-        ref_dirs = get_reference_directions("das-dennis", 4, n_partitions=partitions)
+        ref_dirs = get_reference_directions("das-dennis", n_objectives, n_partitions=partitions)
         return NSGA3(ref_dirs=ref_dirs, pop_size=pop_size, **operators)
     if name == "smsemoa":
         from pymoo.algorithms.moo.sms import SMSEMOA

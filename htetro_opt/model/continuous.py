@@ -49,6 +49,7 @@ __all__ = [
     "enclosing_radius",
     "path_length",
     "path_smoothness",
+    "polyline_segments",
     "robot_distance",
 ]
 
@@ -197,6 +198,29 @@ def path_smoothness(path) -> float:
     a, b = steps[:-1], steps[1:]
     angles = np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1))
     return float(np.degrees(np.abs(angles)).sum())
+
+
+def polyline_segments(points: np.ndarray, sizes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every segment of many polylines stored end to end: ``points`` (N, 2) holds polyline i's
+    ``sizes[i]`` ≥ 1 points after polyline i − 1's. Returns the segments' ends ``a`` and ``b`` and
+    the polyline each belongs to (``owner``); a one-point polyline gives one zero-length segment, so
+    that it is checked too.
+
+    Examples
+    --------
+    >>> a, b, owner = polyline_segments(np.array([[0, 0], [1, 0], [2, 0], [5, 5]]), np.array([3, 1]))
+    >>> a.tolist(), b.tolist(), owner.tolist()
+    ([[0, 0], [1, 0], [5, 5]], [[1, 0], [2, 0], [5, 5]], [0, 0, 1])
+    """
+    ends = np.cumsum(sizes)
+    head = np.ones(len(points), dtype=bool)  # point k starts a segment unless it ends its polyline
+    head[ends - 1] = False
+    heads = np.flatnonzero(head)
+    singles = ends[sizes == 1] - 1
+    a = np.concatenate([points[heads], points[singles]])
+    b = np.concatenate([points[heads + 1], points[singles]])
+    owner = np.concatenate([np.searchsorted(ends, heads, side="right"), np.flatnonzero(sizes == 1)])
+    return a, b, owner
 
 
 def robot_distance(path_a, path_b) -> float:
@@ -452,15 +476,7 @@ class ContinuousGeometry:
             raise
         if (sizes == 0).any():
             raise ParameterError(f"paths[{int(np.argmin(sizes))}] is empty")
-        ends = np.cumsum(sizes)
-        # segment k joins point k to k + 1 unless k is a path's last point; a single point joins itself
-        head = np.ones(len(points), dtype=bool)
-        head[ends - 1] = False
-        heads = np.flatnonzero(head)
-        singles = ends[sizes == 1] - 1
-        a = np.concatenate([points[heads], points[singles]])
-        b = np.concatenate([points[heads + 1], points[singles]])
-        owner = np.concatenate([np.searchsorted(ends, heads, side="right"), np.flatnonzero(sizes == 1)])
+        a, b, owner = polyline_segments(points, sizes)
         ok = self._check(a, b)
         bad = np.zeros(len(paths), dtype=bool)
         np.logical_or.at(bad, owner[~ok], True)

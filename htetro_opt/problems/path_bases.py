@@ -40,7 +40,7 @@ from scipy.interpolate import CubicSpline
 
 from htetro_opt._validation import check_real
 from htetro_opt.errors import ParameterError
-from htetro_opt.model.continuous import path_smoothness, robot_distance
+from htetro_opt.model.continuous import path_smoothness, polyline_segments, robot_distance
 
 __all__ = [
     "PathBasesProblem",
@@ -276,15 +276,7 @@ class PathBasesProblem(Problem):
         lines = [self.polyline(p, k) for ps in parts for k, p in enumerate(ps)]
         sizes = np.fromiter((len(line) for line in lines), np.int64, len(lines))
         points = np.concatenate(lines) if lines else np.empty((0, 2))
-        ends = np.cumsum(sizes)
-        # every segment of every polyline, checked in one call (a lone point joins itself)
-        head = np.ones(len(points), dtype=bool)
-        head[ends - 1] = False
-        heads = np.flatnonzero(head)
-        singles = ends[sizes == 1] - 1
-        a = np.concatenate([points[heads], points[singles]])
-        b = np.concatenate([points[heads + 1], points[singles]])
-        owner = np.concatenate([np.searchsorted(ends, heads, side="right"), np.flatnonzero(sizes == 1)])
+        a, b, owner = polyline_segments(points, sizes)  # every segment of every polyline, checked in one call
         ok = self.geometry.segments_feasible(a, b) if len(a) else np.zeros(0, dtype=bool)
         bad = np.bincount(owner[~ok], minlength=len(lines)).reshape(n, K)
         seg = np.hypot(*(b - a).T)

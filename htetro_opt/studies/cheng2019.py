@@ -48,8 +48,6 @@ not draw: the command line and the notebook ``05_stripe_coverage`` do.
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 import os
 import sys
 from collections.abc import Iterable, Mapping, Sequence
@@ -59,7 +57,7 @@ from typing import Any
 from htetro_opt._files import write_text
 from htetro_opt._validation import check_int
 from htetro_opt.errors import HtetroError, ParameterError
-from htetro_opt.studies.runner import Study, StudyRun
+from htetro_opt.studies.runner import Study, StudyRun, rows_csv
 from htetro_opt.studies.runner import run_study as run_runner_study
 
 __all__ = [
@@ -552,24 +550,6 @@ def report(run: StudyRun, *, figures: Mapping[str, str] | None = None) -> str:
     return "\n".join(out)
 
 
-def _cell(value) -> str:
-    if value is None:
-        return ""
-    return repr(float(value)) if isinstance(value, float) else str(value)
-
-
-def _csv(rows: list[dict]) -> str:
-    fields: list[str] = []
-    for row in rows:
-        fields += [k for k in row if k not in fields]
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(fields)
-    for row in rows:
-        writer.writerow([_cell(row.get(k)) for k in fields])
-    return buffer.getvalue()
-
-
 def write_report(folder: str | os.PathLike, run: StudyRun, *, figures: Mapping[str, str] | None = None,
                  name: str = "cheng2019") -> tuple[Path, Path]:
     """Write :func:`report` as ``folder/<name>.md`` and :func:`report_rows` as ``folder/<name>.csv``,
@@ -588,7 +568,7 @@ def write_report(folder: str | os.PathLike, run: StudyRun, *, figures: Mapping[s
     folder = Path(folder)
     text = report(run, figures=figures)
     return (write_text(folder / f"{name}.md", text, what="study report"),
-            write_text(folder / f"{name}.csv", _csv(report_rows(run)), what="study report"))
+            write_text(folder / f"{name}.csv", rows_csv(report_rows(run)), what="study report"))
 
 
 # --- python -m htetro_opt.studies.cheng2019 ----------------------------------------------------------

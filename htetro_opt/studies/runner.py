@@ -159,6 +159,7 @@ __all__ = [
     "Trial",
     "WorkerLost",
     "coverage_bound",
+    "rows_csv",
     "front_metrics",
     "hypervolume",
     "list_studies",
@@ -1910,7 +1911,9 @@ def _cell(value) -> str:
     return repr(float(value)) if isinstance(value, float) else str(value)
 
 
-def _summary_csv(summary: Sequence[Mapping[str, Any]]) -> str:
+def rows_csv(summary: Sequence[Mapping[str, Any]]) -> str:
+    """Rows of values as CSV text: the union of their keys as columns, in first-seen order; floats
+    written exactly (``repr``), None as an empty cell."""
     fields: list[str] = []
     for row in summary:
         fields += [k for k in row if k not in fields]
@@ -1960,5 +1963,5 @@ def write_summary(summary: Sequence[Mapping[str, Any]], folder: str | os.PathLik
     if not isinstance(name, str) or not _NAME.fullmatch(name):
         raise ParameterError(f"name must be letters, digits, '_', '.' or '-', got {name!r}")
     folder = Path(folder)
-    return (write_text(folder / f"{name}.csv", _summary_csv(summary), what="study summary"),
+    return (write_text(folder / f"{name}.csv", rows_csv(summary), what="study summary"),
             write_text(folder / f"{name}.md", markdown_summary(summary), what="study summary"))

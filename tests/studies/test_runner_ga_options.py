@@ -71,7 +71,7 @@ def test_bad_ga_option_values_name_the_entry_and_key(tmp_path, key, value, match
            f'[methods.per_scenario.random]\n{key} = {value!r}\n'.replace("'", '"')
     path = tmp_path / "bad.toml"
     path.write_text(text.replace("= True", "= true").replace("= False", "= false"))
-    with pytest.raises(StudyError, match=rf"methods\[0\], per_scenario.random: "):
+    with pytest.raises(StudyError, match=r"methods\[0\], per_scenario.random: "):
         load_study(path)
 
 

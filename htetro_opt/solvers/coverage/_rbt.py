@@ -170,7 +170,7 @@ def search_region(region: Region, entry: int, exit: int | None, *, gain: int, bu
 
 
 class _Budget(Exception):
-    pass
+    """The region's node budget is spent: the search keeps its best so far."""
 
 
 def search_simple(region: Region, entry: int, exit: int | None, *, gain: int, budget: int,

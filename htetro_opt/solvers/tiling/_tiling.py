@@ -736,7 +736,7 @@ def _auto_tilings(occ, patterns, seed, deadline, limit):
             if len(found) >= limit:
                 return found
         return found
-    except _OutOfWork:
+    except _OutOfWork:  # the backtracker's step budget is spent: the bands take over below
         pass
     finally:
         generator.close()
@@ -746,7 +746,7 @@ def _auto_tilings(occ, patterns, seed, deadline, limit):
         for turns in (first, first + 2):
             try:
                 return _band_tiling(occ, patterns, seed, deadline, turns)
-            except _OutOfWork:
+            except _OutOfWork:  # these bands proved nothing: from the other end, then CP-SAT on the whole map
                 pass
     return _cpsat_tilings(occ, patterns, seed, deadline, limit)
 
