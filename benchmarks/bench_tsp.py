@@ -21,7 +21,13 @@
    LKH with one run is their reference) and the eq.-2 instance of tiling_64x64 (open path from
    tile 1). Every cost is re-priced here from the matrix, independently of the solvers.
 
-Run:  python benchmarks/bench_tsp.py [--quick] [--parts agreement,ga,scale,tiling,backends] [--seeds N] [--budget S]
+6. TSPLIB (issue 16): eight classic instances (benchmarks/data/tsplib, 51–1002 cities) against their
+   published optima: ``auto`` (ils), fast-tsp, LKH and OR-Tools (``tsplib``), the memetic and plain GA
+   (``tsplib-ga``); the eq.-2 instance of a 128 × 128 map with furniture against LKH (``obstacles``);
+   free maps of 4096–16 384 waypoints tiled and sequenced, time and peak memory (``memory``).
+
+Run:  python benchmarks/bench_tsp.py [--quick] [--seeds N] [--budget S]
+      [--parts agreement,ga,scale,tiling,backends,tsplib,tsplib-ga,obstacles,memory]
 """
 
 from __future__ import annotations
@@ -30,6 +36,7 @@ import argparse
 import platform
 import statistics
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -41,7 +48,7 @@ from htetro_opt.scenarios import (
     load_tileset,
     tileset_path,
 )
-from htetro_opt.scenarios.tsplib import parse_tsplib, tsplib_distances
+from htetro_opt.scenarios.tsplib import load_tsplib, parse_tsplib, tsplib_distances
 from htetro_opt.solvers.sequencing import sequence_waypoints
 from htetro_opt.solvers.tiling import TILING_METHODS, find_tiles, tile_workspace
 
@@ -351,6 +358,130 @@ def backends(quick: bool, budget: float) -> None:
     print()
 
 
+TSPLIB_DIR = Path(__file__).parent / "data" / "tsplib"
+TSPLIB_OPTIMA = {"eil51": 426, "berlin52": 7542, "kroA100": 21282, "ch130": 6110, "a280": 2579, "lin318": 42029,
+                 "pcb442": 50778, "pr1002": 259045}  # TSPLIB's published optima (Reinelt)
+
+
+def tsplib(quick: bool, budget: float) -> None:
+    """Issue 16, item 1: TSPLIB's classic instances (benchmarks/data/tsplib), closed tours, every method's
+    tour re-priced here and held against the published optimum."""
+    runs = [("auto", {"time_limit": budget}), ("fast-tsp", {"time_limit": 1.0}), ("lkh", {"runs": 1}),
+            ("ortools", {"time_limit": budget})]
+    modules = {"fast-tsp": "fast_tsp", "lkh": "elkai"}
+    runs = [(m, o) for m, o in runs if m not in modules or _installed(modules[m])]
+    labels = [m + "".join(f", {k}={v:g}" for k, v in o.items()) for m, o in runs]
+    print("## TSPLIB: gap to the published optimum in % (seconds), closed tours, seed 0\n")
+    print("| instance | n | optimum | " + " | ".join(labels) + " |")
+    print("|---|---:|---:|" + "---:|" * len(runs))
+    names = list(TSPLIB_OPTIMA)[:3] + ["pr1002"] if quick else list(TSPLIB_OPTIMA)
+    gaps = {label: [] for label in labels}
+    for name in names:
+        tsp = load_tsplib(TSPLIB_DIR / f"{name}.tsp")
+        inst = SequencingInstance.from_matrix(tsp.cost, closed=True, start=0)
+        optimum = TSPLIB_OPTIMA[name]
+        cells = []
+        for label, (method, options) in zip(labels, runs):
+            r = sequence_waypoints(inst, method=method, seed=0, **options)
+            cost = _tour_cost(inst.cost, r.order.tolist(), True)
+            assert sorted(r.order.tolist()) == list(range(inst.n)) and abs(cost - r.cost) <= 1e-6 * cost
+            assert cost >= optimum, (name, method, cost)  # nothing beats a proven optimum
+            gap = 100 * (cost - optimum) / optimum
+            gaps[label].append(gap)
+            cells.append(f"{gap:.2f} ({r.runtime_s:.2f})" + (f" [{r.method}]" if method == "auto" else ""))
+        print(f"| {name} | {inst.n} | {optimum} | " + " | ".join(cells) + " |", flush=True)
+    print("| mean gap % | | | " + " | ".join(f"{statistics.mean(g):.2f}" for g in gaps.values()) + " |\n")
+
+
+def tsplib_ga(budget: float) -> None:
+    """Issue 16, item 5: the memetic GA (its local step the compiled local search of ils) and the paper's
+    plain GA on the TSPLIB instances of 130+ cities, closed tours, seed 0, under ``budget`` seconds."""
+    print(f"## The GA on TSPLIB, time_limit={budget:g}: gap to the published optimum\n")
+    print("| instance | n | method | gap % | seconds | generations | stopped |")
+    print("|---|---:|---|---:|---:|---:|---|")
+    for name in ("ch130", "a280", "lin318", "pcb442", "pr1002"):
+        inst = SequencingInstance.from_matrix(load_tsplib(TSPLIB_DIR / f"{name}.tsp").cost, closed=True, start=0)
+        optimum = TSPLIB_OPTIMA[name]
+        for method in ("ga", "ga-plain"):
+            r = sequence_waypoints(inst, method=method, seed=0, time_limit=budget)
+            cost = _tour_cost(inst.cost, r.order.tolist(), True)
+            assert sorted(r.order.tolist()) == list(range(inst.n)) and cost >= optimum
+            print(f"| {name} | {inst.n} | {method} | {100 * (cost - optimum) / optimum:.2f} | {r.runtime_s:.2f} | "
+                  f"{r.info['generations']} | {r.info['stopped']} |", flush=True)
+    print()
+
+
+def obstacles(budget: float) -> None:
+    """Issue 16, item 1: the eq.-2 instance of a 128 × 128 map with furniture (map_furniture(128, 128, 90,
+    seed 0), tiled by auto), open path from tile 1: auto at its default budget and fast-tsp against LKH."""
+    from htetro_opt.model.workspace import Workspace
+
+    began = time.perf_counter()
+    ts = tile_workspace(Workspace(map_furniture(128, 128, 90, 0)), name="furniture 128")
+    inst = SequencingInstance.from_tileset(ts, start=1)
+    print(f"## Eq.-2 instance with obstacles: {inst.n} tiles of map_furniture(128, 128, 90, seed 0), open path "
+          f"from tile 1 (tiled in {time.perf_counter() - began:.1f} s)\n")
+    runs = [("auto", {"time_limit": budget}), ("auto", {}), ("fast-tsp", {"time_limit": budget})]
+    if _installed("elkai"):
+        runs.append(("lkh", {"runs": 1}))  # minutes: last
+    print("| method | cost | seconds | kicks |")
+    print("|---|---:|---:|---:|")
+    results = []
+    for method, options in runs:
+        r = sequence_waypoints(inst, method=method, seed=0, **options)
+        cost = _tour_cost(inst.cost, r.order.tolist(), False)
+        assert sorted(r.order.tolist()) == list(range(inst.n)) and abs(cost - r.cost) <= 1e-6 * cost
+        label = method + "".join(f", {k}={v:g}" for k, v in options.items())
+        results.append((label, cost))
+        print(f"| {label} [{r.method}] | {cost:.2f} | {r.runtime_s:.1f} | {r.info.get('kicks', '')} |", flush=True)
+    reference = results[-1][1] if _installed("elkai") else min(c for _, c in results)
+    print(f"\nGap to {'LKH' if _installed('elkai') else 'the best'} in %: "
+          + ", ".join(f"{label} {100 * (cost - reference) / reference:.2f}" for label, cost in results) + "\n")
+
+
+def _tile_and_sequence(side: int, dense) -> dict:
+    """In a fresh process: tile a free side × side map, sequence it with auto; times and peak memory."""
+    import resource
+
+    from htetro_opt.model.workspace import Workspace
+
+    began = time.perf_counter()
+    ts = tile_workspace(Workspace(np.zeros((side, side), dtype=bool)), name=f"free {side}")
+    tiled = time.perf_counter()
+    inst = SequencingInstance.from_tileset(ts, start=1, dense=dense)
+    built = time.perf_counter()
+    r = sequence_waypoints(inst, seed=0)
+    done = time.perf_counter()
+    order = r.order
+    blocks = ts.blocks.astype(float)  # the cost re-priced here, from the block cells, by a loop of our own
+    cost = sum(float(np.sqrt(((blocks[a] - blocks[b]) ** 2).sum(-1)) @ np.full(4, 0.25))
+               for a, b in zip(order[:-1].tolist(), order[1:].tolist()))
+    assert sorted(order.tolist()) == list(range(inst.n)) and abs(cost - r.cost) <= 1e-6 * cost
+    return {"n": inst.n, "implicit": inst.implicit, "method": r.method, "cost": r.cost, "kicks": r.info.get("kicks"),
+            "tile_s": tiled - began, "instance_s": built - tiled, "sequence_s": done - built, "total_s": done - began,
+            "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
+
+
+def memory(quick: bool) -> None:
+    """Issue 16, item 3: free maps tiled and sequenced by ``auto``, each in a fresh process (its peak RSS)."""
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+
+    print("## Memory linear in n: free maps, tile + sequence (auto), one fresh process each\n")
+    print("| map | waypoints | costs | tile s | instance s | sequence s | total s | peak RSS MB | cost | kicks |")
+    print("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|")
+    cases = [(128, None), (180, None), (256, None)] if not quick else [(128, None), (256, None)]
+    if not quick:
+        cases.insert(2, (180, True))  # 8100 waypoints with the dense matrix, for comparison
+    for side, dense in cases:
+        with ProcessPoolExecutor(1, mp_context=get_context("spawn")) as pool:
+            row = pool.submit(_tile_and_sequence, side, dense).result()
+        print(f"| free {side} × {side} | {row['n']} | {'implicit' if row['implicit'] else 'matrix'} | "
+              f"{row['tile_s']:.1f} | {row['instance_s']:.1f} | {row['sequence_s']:.1f} | {row['total_s']:.1f} | "
+              f"{row['peak_mb']:.0f} | {row['cost']:.1f} | {row['kicks']} |", flush=True)
+    print()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true")
@@ -370,6 +501,14 @@ def main() -> None:
         tiling(args.quick)
     if "backends" in parts:
         backends(args.quick, args.budget)
+    if "memory" in parts:
+        memory(args.quick)
+    if "tsplib" in parts:
+        tsplib(args.quick, args.budget)
+    if "tsplib-ga" in parts:
+        tsplib_ga(args.budget)
+    if "obstacles" in parts:
+        obstacles(30.0)
 
 
 if __name__ == "__main__":

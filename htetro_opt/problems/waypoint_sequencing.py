@@ -39,6 +39,8 @@ __all__ = [
     "check_weights",
     "block_locations",
     "cost_matrix",
+    "eq2_legs",
+    "DENSE_LIMIT",
     "path_cost",
     "SequencingInstance",
     "OpenPathReduction",
@@ -49,6 +51,12 @@ __all__ = [
 
 DEFAULT_BLOCK_WEIGHTS = (0.25, 0.25, 0.25, 0.25)
 """α, β, λ, γ of eq. 2: every block counts the same."""
+
+DENSE_LIMIT = 5000
+"""Above this many waypoints :meth:`SequencingInstance.from_tileset` keeps the eq.-2 costs implicit
+(computed from the block cells when needed) instead of an n × n matrix: 8·n² bytes, 2.1 GB at 16 384
+waypoints, which the ``ils`` method does not need (benchmarks/README.md, "TSPLIB, a map with
+obstacles, memory linear in n": 317 MB to tile and sequence 16 384 waypoints)."""
 
 
 def check_weights(weights) -> np.ndarray:
@@ -99,8 +107,28 @@ def cost_matrix(blocks, weights=DEFAULT_BLOCK_WEIGHTS) -> np.ndarray:
     """
     w = check_weights(weights)
     b = _block_cells(blocks).astype(float)
-    distance = np.sqrt(((b[:, None] - b[None, :]) ** 2).sum(-1))
-    return distance @ w
+    n = len(b)
+    out = np.empty((n, n))
+    # rows in blocks: the (rows, n, 4, 2) differences of one block stay near 64 MB, not 64 B·n²
+    step = max(1, (1 << 23) // max(1, 8 * n))
+    for r in range(0, n, step):
+        out[r:r + step] = np.sqrt(((b[r:r + step, None] - b[None, :]) ** 2).sum(-1)) @ w
+    return out
+
+
+def eq2_legs(blocks, weights, a, b) -> np.ndarray:
+    """Eq. 2 between waypoints ``a[k]`` and ``b[k]`` (arrays of indices), without a matrix.
+
+    Examples
+    --------
+    >>> blocks = np.array([[(0, 0), (0, 1), (0, 2), (0, 3)], [(3, 0), (3, 1), (3, 2), (3, 3)]])
+    >>> eq2_legs(blocks, DEFAULT_BLOCK_WEIGHTS, [0, 1], [1, 1]).tolist()
+    [3.0, 0.0]
+    """
+    w = check_weights(weights)
+    cells = _block_cells(blocks).astype(float)
+    a, b = np.asarray(a, dtype=np.int64), np.asarray(b, dtype=np.int64)
+    return np.sqrt(((cells[a] - cells[b]) ** 2).sum(-1)) @ w
 
 
 def _block_cells(blocks) -> np.ndarray:
@@ -250,9 +278,11 @@ class SequencingInstance:
 
     Parameters
     ----------
-    cost : ndarray of float, shape (n, n)
+    cost : ndarray of float, shape (n, n), or None
         Cost of moving from waypoint i to waypoint j: eq. 2 for a tileset (symmetric, zero diagonal),
-        any finite numbers for :meth:`from_matrix` (the diagonal is never used).
+        any finite numbers for :meth:`from_matrix` (the diagonal is never used). None: the eq.-2
+        costs of ``blocks`` under ``weights``, computed when needed (an *implicit* instance, memory
+        linear in n; only ``ils`` sequences it, see :data:`DENSE_LIMIT`).
     blocks : ndarray of int, shape (n, 4, 2), or None
         Cells of blocks a–d at each waypoint (the pattern baselines scan block b's cell); None for an
         instance without tile geometry (:meth:`from_matrix`), which the pattern baselines refuse.
@@ -268,11 +298,14 @@ class SequencingInstance:
         (the paper's problem): an open path.
     end : int or None
         Open paths only: the index of the waypoint every order ends at, or None for a free end.
+    weights : sequence of 4 float, or None
+        The eq.-2 weights of an implicit instance (None: :data:`DEFAULT_BLOCK_WEIGHTS`); ignored
+        when ``cost`` is given.
 
     Raises
     ------
     PlanningError
-        If the cost matrix is not square, non-empty and finite.
+        If the cost matrix is not square, non-empty and finite, or an implicit instance has no blocks.
     ParameterError
         If ``start`` or ``end`` is not None or a waypoint index, ``end`` is given for a closed tour or
         equals ``start`` on an open path of more than one waypoint, or an argument has the wrong type
@@ -286,16 +319,25 @@ class SequencingInstance:
     shape: tuple[int, int] = (0, 0)
     closed: bool = False
     end: int | None = None
+    weights: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
-        try:
-            cost = np.array(self.cost, dtype=float)
-        except (TypeError, ValueError) as err:
-            raise ParameterError(f"cost must be a square matrix of numbers, got {type(self.cost).__name__} "
-                                 f"{reprlib.repr(self.cost)}") from err
-        n = len(cost) if cost.ndim else 0
-        if cost.shape != (n, n) or n == 0 or not np.isfinite(cost).all():
-            raise PlanningError(f"the cost matrix must be square, non-empty and finite, got shape {cost.shape}")
+        weights = None
+        if self.cost is None:  # implicit eq.-2 costs
+            if self.blocks is None or len(_block_cells(self.blocks)) == 0:
+                raise PlanningError("an instance without a cost matrix needs the block cells of its waypoints")
+            weights = tuple(check_weights(DEFAULT_BLOCK_WEIGHTS if self.weights is None else self.weights).tolist())
+            cost = None
+            n = len(_block_cells(self.blocks))
+        else:
+            try:
+                cost = np.array(self.cost, dtype=float)
+            except (TypeError, ValueError) as err:
+                raise ParameterError(f"cost must be a square matrix of numbers, got {type(self.cost).__name__} "
+                                     f"{reprlib.repr(self.cost)}") from err
+            n = len(cost) if cost.ndim else 0
+            if cost.shape != (n, n) or n == 0 or not np.isfinite(cost).all():
+                raise PlanningError(f"the cost matrix must be square, non-empty and finite, got shape {cost.shape}")
         start = check_int(self.start, "start", minimum=0, maximum=n - 1, allow_none=True)
         closed = check_bool(self.closed, "closed")
         end = check_int(self.end, "end", minimum=0, maximum=n - 1, allow_none=True)
@@ -321,8 +363,10 @@ class SequencingInstance:
         if len(ids) != n or len(shape) != 2:
             raise ParameterError(f"need one tile id per waypoint ({n}) and a grid shape (H, W), got {len(ids)} ids "
                                  f"and shape {shape}")
-        cost.setflags(write=False)
+        if cost is not None:
+            cost.setflags(write=False)
         object.__setattr__(self, "cost", cost)
+        object.__setattr__(self, "weights", weights)
         object.__setattr__(self, "blocks", blocks)
         object.__setattr__(self, "ids", ids)
         object.__setattr__(self, "start", start)
@@ -332,13 +376,19 @@ class SequencingInstance:
 
     @classmethod
     def from_tileset(cls, tileset: Tileset, *, start: int | None = 1,
-                     weights=DEFAULT_BLOCK_WEIGHTS) -> "SequencingInstance":
+                     weights=DEFAULT_BLOCK_WEIGHTS, dense: bool | None = None) -> "SequencingInstance":
         """The instance of a labelled tileset.
 
         Parameters
         ----------
         start : int or None
             The label of the start tile (tile 1 by default), or None for a free start.
+        weights : sequence of 4 float
+            α, β, λ, γ of eq. 2.
+        dense : bool or None
+            True: hold the n × n eq.-2 matrix (every method can run); False: keep the costs implicit
+            (memory linear in n; ``ils`` and ``auto`` only); None (default): dense up to
+            :data:`DENSE_LIMIT` waypoints.
 
         Raises
         ------
@@ -357,11 +407,15 @@ class SequencingInstance:
         ([[0.0, 1.0], [1.0, 0.0]], 0)
         """
         check_tileset(tileset)
+        w = check_weights(weights)
+        dense = None if dense is None else check_bool(dense, "dense")
         if len(tileset) == 0:
             raise PlanningError(f"{tileset.name or 'tileset'} has no tiles to sequence")
         index = None if start is None else tileset.index(start)
-        return cls(cost_matrix(tileset.blocks, weights), tileset.blocks, index, tileset.ids,
-                   tileset.occupancy.shape)
+        if dense is None:
+            dense = len(tileset) <= DENSE_LIMIT
+        cost = cost_matrix(tileset.blocks, w) if dense else None
+        return cls(cost, tileset.blocks, index, tileset.ids, tileset.occupancy.shape, weights=tuple(w.tolist()))
 
     @classmethod
     def from_matrix(cls, matrix, *, closed: bool = False, start: int | None = None, end: int | None = None,
@@ -404,12 +458,33 @@ class SequencingInstance:
 
     @property
     def n(self) -> int:
-        return len(self.cost)
+        return len(self.blocks) if self.cost is None else len(self.cost)
+
+    @property
+    def implicit(self) -> bool:
+        """Whether the costs are eq. 2 of the blocks, computed when needed, with no n × n matrix."""
+        return self.cost is None
 
     @cached_property
     def symmetric(self) -> bool:
         """Whether ``cost`` is symmetric (to 1e-9 relative): the methods that assume it check this."""
+        if self.cost is None:
+            return True  # eq. 2 is
         return bool(np.allclose(self.cost, self.cost.T, rtol=1e-9, atol=1e-12))
+
+    def legs(self, a, b) -> np.ndarray:
+        """The costs of the moves ``a[k] → b[k]`` (waypoint indices), from the matrix or from eq. 2.
+
+        Examples
+        --------
+        >>> inst = SequencingInstance.from_matrix([[0, 1, 9], [1, 0, 2], [9, 2, 0]])
+        >>> inst.legs([0, 2], [1, 0]).tolist()
+        [1.0, 9.0]
+        """
+        a, b = np.asarray(a, dtype=np.int64), np.asarray(b, dtype=np.int64)
+        if self.cost is None:
+            return eq2_legs(self.blocks, self.weights, a, b)
+        return self.cost[a, b]
 
     @property
     def has_geometry(self) -> bool:
@@ -418,10 +493,17 @@ class SequencingInstance:
 
     def path_cost(self, order) -> float:
         """Summed cost of an order (waypoint indices); a closed tour adds the leg back to its first."""
-        total = path_cost(self.cost, order)
+        if self.cost is None:
+            order = np.asarray(order)
+            if order.ndim != 1 or order.size and (not np.issubdtype(order.dtype, np.integer) or order.min() < 0
+                                                  or order.max() >= self.n):
+                raise ParameterError(f"order must be waypoint indices in 0…{self.n - 1}, got {reprlib.repr(order)}")
+            total = float(self.legs(order[:-1], order[1:]).sum())
+        else:
+            total = path_cost(self.cost, order)
         if self.closed and np.size(order) > 1:
             order = np.asarray(order, dtype=np.int64)
-            total += float(self.cost[order[-1], order[0]])
+            total += float(self.legs(order[-1:], order[:1])[0])
         return total
 
     def check_order(self, order) -> np.ndarray:
@@ -497,6 +579,10 @@ def reduce_to_open_path(instance: SequencingInstance) -> OpenPathReduction:
     (7.0, 7.0)
     """
     instance = check_instance(instance)
+    if instance.implicit:
+        raise ParameterError(f"this instance of {instance.n} waypoints keeps its eq.-2 costs implicit (no n × n "
+                             "matrix), which the open-path reduction needs: build it with "
+                             "SequencingInstance.from_tileset(..., dense=True), or use method 'ils' (or auto)")
     n, C, blocks = instance.n, instance.cost, instance.blocks
     start, end, ids = instance.start, instance.end, instance.ids
     copied = instance.closed and n > 1

@@ -172,3 +172,67 @@ def test_pymoo_ga_runs_on_the_problem_and_its_best_order_is_valid():
     # 40 generations of 20 on 6! = 720 orders: the GA finds the optimum, and reports its cost
     assert walk(points, order) == pytest.approx(brute)
     assert res.F[0] == pytest.approx(brute)
+
+
+# ---------------------------------------------------------------- implicit (matrix-free) instances
+def _random_tileset_blocks(n, seed):
+    rng = np.random.default_rng(seed)
+    return rng.integers(0, 60, size=(n, 4, 2))
+
+
+def test_cost_matrix_in_row_blocks_equals_the_formula_entry_by_entry(monkeypatch):
+    import htetro_opt.problems.waypoint_sequencing as ws
+
+    blocks = _random_tileset_blocks(23, 0)
+    w = (0.1, 0.2, 0.3, 0.4)
+    C = cost_matrix(blocks, w)
+    for i, j in [(0, 1), (5, 17), (22, 3), (9, 9)]:
+        expected = sum(w[l] * math.dist(blocks[i, l], blocks[j, l]) for l in range(4))
+        assert C[i, j] == pytest.approx(expected)
+    assert np.allclose(ws.eq2_legs(blocks, w, [0, 5, 22], [1, 17, 3]), C[[0, 5, 22], [1, 17, 3]])
+
+
+def test_implicit_instance_prices_like_the_dense_one():
+    from htetro_opt.problems.waypoint_sequencing import DENSE_LIMIT
+
+    ts = parse_tileset("1a 1b 1c 1d\n2a 2b 2c 2d\n3a 3b 3c 3d\n4d 4c 4b 4a")
+    dense = SequencingInstance.from_tileset(ts, start=2)
+    implicit = SequencingInstance.from_tileset(ts, start=2, dense=False)
+    assert dense.cost is not None and not dense.implicit and implicit.cost is None and implicit.implicit
+    assert len(ts) <= DENSE_LIMIT and implicit.n == dense.n == 4 and implicit.symmetric
+    rng = np.random.default_rng(1)
+    for _ in range(5):
+        order = np.concatenate([[1], rng.permutation([0, 2, 3])])
+        priced = sum(dense.cost[a, b] for a, b in itertools.pairwise(order))
+        assert implicit.path_cost(order) == pytest.approx(priced) == pytest.approx(dense.path_cost(order))
+    closed = SequencingInstance(None, ts.blocks, 0, closed=True, weights=(0, 1, 0, 0))
+    b = ts.blocks[:, 1]  # weights (0, 1, 0, 0): block b's walk, back to the first
+    assert closed.path_cost([0, 1, 2, 3]) == pytest.approx(sum(math.dist(b[i], b[(i + 1) % 4]) for i in range(4)))
+
+
+def test_from_tileset_keeps_the_costs_implicit_above_the_dense_limit(monkeypatch):
+    import htetro_opt.problems.waypoint_sequencing as ws
+
+    ts = parse_tileset("1a 1b 1c 1d\n2a 2b 2c 2d\n3a 3b 3c 3d")
+    monkeypatch.setattr(ws, "DENSE_LIMIT", 2)
+    assert SequencingInstance.from_tileset(ts).implicit
+    assert not SequencingInstance.from_tileset(ts, dense=True).implicit
+    monkeypatch.setattr(ws, "DENSE_LIMIT", 3)
+    assert not SequencingInstance.from_tileset(ts).implicit
+
+
+def test_implicit_instances_refuse_what_needs_a_matrix():
+    from htetro_opt.problems.waypoint_sequencing import reduce_to_open_path
+
+    ts = parse_tileset("1a 1b 1c 1d\n2a 2b 2c 2d\n3a 3b 3c 3d")
+    implicit = SequencingInstance.from_tileset(ts, dense=False)
+    with pytest.raises(ParameterError, match="implicit"):
+        reduce_to_open_path(implicit)
+    with pytest.raises(PlanningError, match="block cells"):
+        SequencingInstance(None)
+    with pytest.raises(ParameterError, match="dense"):
+        SequencingInstance.from_tileset(ts, dense="yes")
+    with pytest.raises(ParameterError, match="weights"):
+        SequencingInstance(None, ts.blocks, weights=(1, 2))
+    with pytest.raises(ParameterError, match="order"):
+        implicit.path_cost([0, 1, 7])

@@ -1,7 +1,11 @@
 """TSPLIB files: every edge-weight type against hand-computed distances, TSPLIB's published optima
 of two small public instances (data inline), bad files, and ``htetro-opt sequence FILE.tsp``."""
 
+import itertools
 import json
+import math
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -259,3 +263,33 @@ def test_cli_bad_tsplib_files_are_one_error_line(capsys, tmp_path):
         code, out, err = run(capsys, ["sequence", str(path), "--json"])
         assert code == 2 and out == ""
         assert len(err.splitlines()) == 1 and err.startswith("error: ") and word in err
+
+
+# The eight classic instances the benchmarks measure against (benchmarks/data/tsplib, README there),
+# with TSPLIB's published optima, and the optimal tours stored beside seven of them.
+STORED = Path(__file__).resolve().parents[2] / "benchmarks" / "data" / "tsplib"
+STORED_OPTIMA = {"eil51": 426, "berlin52": 7542, "kroA100": 21282, "ch130": 6110, "a280": 2579, "lin318": 42029,
+                 "pcb442": 50778, "pr1002": 259045}
+
+
+@pytest.mark.parametrize("name", sorted(STORED_OPTIMA))
+def test_stored_instances_are_complete(name):
+    text = (STORED / f"{name}.tsp").read_text()
+    dimension = int(re.search(r"DIMENSION\s*:\s*(\d+)", text).group(1))
+    rows = [line.split() for line in text.split("NODE_COORD_SECTION")[1].split("EOF")[0].splitlines() if line.strip()]
+    assert [int(r[0]) for r in rows] == list(range(1, dimension + 1)) and all(len(r) == 3 for r in rows)
+    tsp = load_tsplib(STORED / f"{name}.tsp")
+    assert tsp.name == name and tsp.dimension == dimension and tsp.coords.shape == (dimension, 2)
+
+
+@pytest.mark.parametrize("name", sorted(n for n in STORED_OPTIMA if (STORED / f"{n}.opt.tour").exists()))
+def test_stored_optimal_tours_cost_the_published_optima(name):
+    tsp = load_tsplib(STORED / f"{name}.tsp")
+    numbers = (STORED / f"{name}.opt.tour").read_text().split("TOUR_SECTION")[1].split()
+    tour = [int(v) - 1 for v in itertools.takewhile(lambda v: v not in ("-1", "EOF"), numbers)]
+    assert sorted(tour) == list(range(tsp.dimension))
+    # priced by the reader's matrix and, independently, by EUC_2D's rule on the coordinates
+    xy = tsp.coords
+    by_hand = sum(math.floor(math.dist(xy[a], xy[b]) + 0.5) for a, b in zip(tour, tour[1:] + tour[:1]))
+    by_matrix = sum(tsp.cost[a, b] for a, b in zip(tour, tour[1:] + tour[:1]))
+    assert by_hand == by_matrix == STORED_OPTIMA[name]

@@ -21,7 +21,10 @@ function of its own:
 
 Instances may be closed tours or open paths with a fixed end, from any cost matrix
 (:meth:`~htetro_opt.problems.SequencingInstance.from_matrix`) or a TSPLIB file
-(:func:`htetro_opt.scenarios.tsplib.load_tsplib`).
+(:func:`htetro_opt.scenarios.tsplib.load_tsplib`). A tileset of more than
+:data:`~htetro_opt.problems.waypoint_sequencing.DENSE_LIMIT` waypoints keeps its eq.-2 costs
+implicit (no n × n matrix, memory linear in n); ``ils`` (and so ``auto``) sequences it, the other
+methods ask for ``from_tileset(..., dense=True)``.
 """
 
 from htetro_opt._lazy import attach

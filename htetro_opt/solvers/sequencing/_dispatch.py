@@ -42,12 +42,13 @@ __all__ = [
 ]
 
 # name → (module, function, preset options, capabilities): "asymmetric" (asymmetric costs allowed),
-# "tours" (closed tours and fixed ends taken natively), "geometry" (needs the tiles' block cells)
+# "tours" (closed tours and fixed ends taken natively), "geometry" (needs the tiles' block cells),
+# "implicit" (sequences an instance without a cost matrix, SequencingInstance.implicit)
 _METHODS = {
     "exact": ("._exact", "solve_exact", {}, {"asymmetric"}),
     "ortools": ("._ortools", "solve_ortools", {}, {"asymmetric"}),
     "local": ("._local", "solve_local", {}, set()),
-    "ils": ("._ils", "solve_ils", {}, {"tours"}),
+    "ils": ("._ils", "solve_ils", {}, {"tours", "implicit"}),
     # the memetic GA finds its best within a few generations; 50 more without improvement suffice
     "ga": ("._ga", "solve_ga", {"memetic": True, "patience": 50}, set()),
     "ga-plain": ("._ga", "solve_ga", {"memetic": False}, set()),
@@ -104,7 +105,7 @@ def auto_method(instance: SequencingInstance) -> str:
     """The method ``method="auto"`` runs on ``instance``.
 
     ``exact`` up to :data:`EXACT_AUTO_LIMIT` waypoints (a closed tour counts its copied first
-    waypoint too). Beyond, for symmetric costs, ``ils`` (the compiled iterated local search, whose
+    waypoint too). Beyond, and for an implicit instance (no cost matrix), for symmetric costs, ``ils`` (the compiled iterated local search, whose
     budget is counted in kicks: the same seed gives the same order on every machine; numba, which
     compiles it, is a core dependency); ``ortools`` for asymmetric costs.
 
@@ -120,6 +121,8 @@ def auto_method(instance: SequencingInstance) -> str:
     ('exact', 'ortools')
     """
     instance = check_instance(instance)
+    if instance.implicit:
+        return "ils"
     size = instance.n + (1 if instance.closed and instance.n > 1 else 0)
     if size <= EXACT_AUTO_LIMIT:
         return "exact"
@@ -137,6 +140,10 @@ def _resolve(method, instance: SequencingInstance) -> tuple[str, object, dict, s
         raise ParameterError(f"unknown sequencing method {method!r}: expected one of {', '.join(SEQUENCE_METHODS)} "
                              "or a callable")
     module, function, preset, capabilities = _METHODS[method]
+    if instance.implicit and "implicit" not in capabilities:
+        raise ParameterError(f"method {method!r} needs the cost matrix, and this instance of {instance.n} waypoints "
+                             "keeps its eq.-2 costs implicit (above DENSE_LIMIT waypoints): use ils or auto, or "
+                             "SequencingInstance.from_tileset(..., dense=True)")
     if "geometry" in capabilities and not instance.has_geometry:
         raise ParameterError(f"method {method!r} scans the tiles' positions, and this instance has no tile geometry "
                              "(a plain cost matrix): use another method, e.g. auto")

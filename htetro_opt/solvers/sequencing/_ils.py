@@ -11,7 +11,17 @@ The search (a choice of ours, after the classic 2-opt + Or-opt local search with
 and don't-look bits, and iterated local search with double-bridge kicks of Lourenço, Martin and
 Stützle 2003):
 
-- **Neighbour lists**: each node's :data:`ILS_NEIGHBOURS` cheapest other nodes.
+- **Costs**: the dense matrix, or, for an implicit instance (no n × n matrix, above
+  :data:`~htetro_opt.problems.waypoint_sequencing.DENSE_LIMIT` waypoints), eq. 2 computed from the
+  block cells at each look-up, so that memory stays linear in n (benchmarks/README.md, "TSPLIB,
+  a map with obstacles, memory linear in n"). The kernel is compiled once per kind (:func:`_d`), so
+  the dense case pays nothing for the other.
+- **Neighbour lists**: each node's :data:`ILS_NEIGHBOURS` cheapest other nodes: from the matrix, or
+  (implicit) the cheapest by eq. 2 among the ``4k`` nearest by the weighted centre of the blocks, a
+  k-d tree query (eq. 2 is at least Σw times the centres' distance). Each node's legs to its
+  neighbours are priced once per run.
+- **Start**: the nearest-neighbour tour from node 0 (dense), or the waypoints along a Hilbert curve
+  through their block centres (implicit: nearest neighbour needs every row of the matrix).
 - **Local search**: a queue of active nodes (the don't-look bits: a node whose moves all failed
   leaves the queue until an edge at it changes). For an active node ``a``, every 2-opt move that
   creates an edge from ``a`` (either tour direction) to a neighbour cheaper than the edge it
@@ -28,23 +38,25 @@ Stützle 2003):
   says so (``info["timed_out"]``) and is no longer reproducible.
 
 The kernel is compiled by numba (≥ 0.59, a core dependency, so that ``auto`` gives the same order on
-every install). Should it be missing,
+every install). :class:`LocalCore` runs the same local search (no kicks) on given orders: the
+memetic GA's local step. Should numba be missing,
 ``ils`` runs the pure-numpy ``local`` method with restarts under the same time cap instead, and says
 so in ``info["engine"]``: its results are worse (benchmarks/README.md) and depend on the clock.
 """
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
 
 from htetro_opt._validation import as_rng, check_int, check_time_limit
 from htetro_opt.errors import ParameterError
-from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance
+from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance, eq2_legs
 from htetro_opt.solvers.sequencing._budgets import default_time_limit
 
-__all__ = ["HAVE_NUMBA", "ILS_KICK_SPAN", "ILS_NEIGHBOURS", "ils_kicks", "solve_ils"]
+__all__ = ["HAVE_NUMBA", "ILS_KICK_SPAN", "ILS_NEIGHBOURS", "LocalCore", "ils_kicks", "solve_ils"]
 
 ILS_NEIGHBOURS = 8
 """Size of each node's neighbour (candidate) list."""
@@ -54,6 +66,8 @@ ILS_KICK_SPAN = 100
 
 try:  # pragma: no cover - depends on the environment
     import numba
+
+    from numba.extending import overload
 
     _jit = numba.njit(cache=True, nogil=True)
     HAVE_NUMBA = True
@@ -68,14 +82,17 @@ except ImportError:  # pragma: no cover
 
 
 def ils_kicks(n: int) -> int:
-    """The number of kicks ``ils`` makes on ``n`` nodes: ``400 · n`` + 1000, at most 2 000 000.
+    """The number of kicks ``ils`` makes on ``n`` nodes: ``400 · n`` + 1000, at most 1 000 000.
+
+    The cap keeps large instances within about a minute (1.5 M kicks on the 3868-waypoint furniture
+    map of benchmarks/README.md ended 0.01 % below where 0.6 M did).
 
     Examples
     --------
     >>> ils_kicks(100), ils_kicks(1000), ils_kicks(100_000)
-    (41000, 401000, 2000000)
+    (41000, 401000, 1000000)
     """
-    return int(min(2_000_000, 400 * n + 1000))
+    return int(min(1_000_000, 400 * n + 1000))
 
 
 # ------------------------------------------------------------------------------------ the kernel
@@ -155,8 +172,41 @@ def _or_move(tour, pos, log, count, p, s1, s2, nx, x, y, forward):
     return count
 
 
+def _d(cm, a, b):
+    """The cost of the leg (a, b). ``cm`` is a dense matrix, or the tuple ``(P, w, pen)`` of an implicit
+    instance: block cells ``P`` (m, 4, 2) and weights ``w`` of eq. 2, ``pen[j]`` the leg from the
+    dummy node ``m`` to node ``j``. (Plain Python; the kernel's compiled twin is below.)"""
+    return cm[a, b] if isinstance(cm, np.ndarray) else _eq2(cm, a, b)
+
+
+def _eq2(cm, a, b):
+    """Eq. 2 of an implicit instance's leg (a, b), or the dummy's leg."""
+    P, w, pen = cm
+    m = P.shape[0]
+    if a == m:
+        return pen[b]
+    if b == m:
+        return pen[a]
+    total = 0.0
+    for block in range(4):
+        dx = P[a, block, 0] - P[b, block, 0]
+        dy = P[a, block, 1] - P[b, block, 1]
+        total += w[block] * math.sqrt(dx * dx + dy * dy)
+    return total
+
+
+if HAVE_NUMBA:
+    # Chosen by type when the kernel compiles, so a dense matrix costs one load, as if written inline:
+    # a run-time branch between the two (or a call LLVM does not inline) made the kernel 8x slower.
+    @overload(_d, jit_options={"cache": True})
+    def _d_compiled(cm, a, b):
+        if isinstance(cm, numba.types.Array):
+            return lambda cm, a, b: cm[a, b]
+        return _eq2
+
+
 @_jit
-def _local_search(D, nbr, tour, pos, queue, queued, head, size, log, count, eps):
+def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count, eps):
     """Improve the tour from the queued nodes until the queue is empty; (gain, moves logged)."""
     n = tour.shape[0]
     k = nbr.shape[1]
@@ -175,10 +225,10 @@ def _local_search(D, nbr, tour, pos, queue, queued, head, size, log, count, eps)
                 b = tour[(pos[a] + 1) % n]
             else:
                 b = tour[(pos[a] - 1) % n]
-            d_ab = D[a, b]
+            d_ab = _d(cm, a, b)
             for t in range(k):
                 c = nbr[a, t]
-                g1 = d_ab - D[a, c]
+                g1 = d_ab - nc[a, t]
                 if g1 <= eps:
                     break
                 if direction == 0:
@@ -187,7 +237,7 @@ def _local_search(D, nbr, tour, pos, queue, queued, head, size, log, count, eps)
                     d = tour[(pos[c] - 1) % n]
                 if c == b or d == a:
                     continue
-                gain = g1 + D[c, d] - D[b, d]
+                gain = g1 + _d(cm, c, d) - _d(cm, b, d)
                 if gain > eps:
                     if direction == 0:
                         _two_opt(tour, pos, a, b, c, d)
@@ -220,12 +270,12 @@ def _local_search(D, nbr, tour, pos, queue, queued, head, size, log, count, eps)
                 s2 = tour[(i + length - 1) % n]
                 p = tour[(i - 1) % n]
                 nx = tour[(i + length) % n]
-                removal = D[p, s1] + D[s2, nx] - D[p, nx]
+                removal = _d(cm, p, s1) + _d(cm, s2, nx) - _d(cm, p, nx)
                 if removal <= eps:
                     continue
                 for t in range(k):
                     c = nbr[a, t]
-                    if removal - D[a, c] <= eps:
+                    if removal - nc[a, t] <= eps:
                         break
                     # c must lie outside the segment
                     off = (pos[c] - i) % n
@@ -241,9 +291,9 @@ def _local_search(D, nbr, tour, pos, queue, queued, head, size, log, count, eps)
                             continue
                         if (pos[x] - i) % n < length or (pos[y] - i) % n < length:
                             continue
-                        base = removal + D[x, y]
-                        fwd = base - D[x, s1] - D[s2, y]
-                        rev = base - D[x, s2] - D[s1, y]
+                        base = removal + _d(cm, x, y)
+                        fwd = base - _d(cm, x, s1) - _d(cm, s2, y)
+                        rev = base - _d(cm, x, s2) - _d(cm, s1, y)
                         if fwd >= rev and fwd > eps:
                             count = _or_move(tour, pos, log, count, p, s1, s2, nx, x, y, True)
                             gain_total += fwd
@@ -262,16 +312,16 @@ def _local_search(D, nbr, tour, pos, queue, queued, head, size, log, count, eps)
 
 
 @_jit
-def _tour_cost(D, tour):
+def _tour_cost(cm, tour):
     n = tour.shape[0]
     total = 0.0
     for i in range(n):
-        total += D[tour[i], tour[(i + 1) % n]]
+        total += _d(cm, tour[i], tour[(i + 1) % n])
     return total
 
 
 @_jit
-def _ils(D, nbr, tour, kicks, span, seed, eps):
+def _ils(cm, nbr, tour, kicks, span, seed, eps):
     """Local search, then ``kicks`` kicks (double bridges); the tour in place. Returns (kicks done,
     kicks that lowered the cost)."""
     n = tour.shape[0]
@@ -283,11 +333,17 @@ def _ils(D, nbr, tour, kicks, span, seed, eps):
     log = np.empty((4 * n + 64, 4), dtype=np.int64)
     state = np.empty(1, dtype=np.uint64)
     state[0] = np.uint64(seed)
+    # each node's legs to its neighbours, the search's most frequent lookups, priced once (eq. 2 has
+    # four square roots a leg)
+    nc = np.empty(nbr.shape)
+    for a in range(nbr.shape[0]):
+        for t in range(nbr.shape[1]):
+            nc[a, t] = _d(cm, a, nbr[a, t])
     head = 0
     size = 0
     for i in range(n):
         size = _push(queue, queued, head, size, tour[i])
-    _, head, _ = _local_search(D, nbr, tour, pos, queue, queued, head, size, log, 0, eps)
+    _, head, _ = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, 0, eps)
     size = 0
     kept = 0
     done = 0
@@ -306,7 +362,8 @@ def _ils(D, nbr, tour, kicks, span, seed, eps):
         c1 = tour[(start + l1 + 1) % n]
         c2 = tour[(start + l1 + l2) % n]
         d1 = tour[(start + l1 + l2 + 1) % n]
-        delta = (D[a1, c1] + D[c2, b1] + D[b2, d1]) - (D[a1, b1] + D[b2, c1] + D[c2, d1])
+        delta = (_d(cm, a1, c1) + _d(cm, c2, b1) + _d(cm, b2, d1)
+                 - _d(cm, a1, b1) - _d(cm, b2, c1) - _d(cm, c2, d1))
         count = 0
         _two_opt(tour, pos, a1, b1, c2, d1)
         count = _log(log, count, a1, b1, c2, d1)
@@ -316,7 +373,7 @@ def _ils(D, nbr, tour, kicks, span, seed, eps):
         count = _log(log, count, c2, b2, b1, d1)
         for node in (a1, b1, b2, c1, c2, d1):
             size = _push(queue, queued, head, size, node)
-        gain, head, count = _local_search(D, nbr, tour, pos, queue, queued, head, size, log, count, eps)
+        gain, head, count = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count, eps)
         size = 0
         if delta - gain <= eps and count <= log.shape[0]:
             if delta - gain < -eps:
@@ -332,31 +389,115 @@ def _ils(D, nbr, tour, kicks, span, seed, eps):
 
 
 # ------------------------------------------------------------------------------------- the method
-def _closed_matrix(instance: SequencingInstance) -> tuple[np.ndarray, int | None]:
-    """The symmetric closed-tour matrix (module docstring) and the dummy's index (None: closed)."""
-    C = (instance.cost + instance.cost.T) / 2
+def _cost_model(instance: SequencingInstance) -> tuple[tuple, int, int | None, float]:
+    """The closed, symmetric tour the kernel solves (module docstring): ``(cm, m, dummy, top)``.
+
+    ``cm`` for :func:`_d`: the dense matrix of ``m`` nodes (the instance's symmetrised, plus the
+    dummy), or, for an implicit instance, the block cells ``P``, weights ``w`` and the dummy's legs
+    ``pen``; ``dummy`` is the dummy's index (None: closed); ``top``
+    bounds every leg's cost.
+    """
     n = instance.n
-    if instance.closed:
-        return np.ascontiguousarray(C), None
-    penalty = 3.0 * float(np.abs(C).max()) + 1.0
-    D = np.zeros((n + 1, n + 1))
-    D[:n, :n] = C
     pinned = [i for i in (instance.start, instance.end) if i is not None]
-    if pinned:
-        D[n, :n] = penalty
-        D[n, pinned] = 0.0
-        D[:n, n] = D[n, :n]
-    return D, n
+    if instance.implicit:
+        P = np.ascontiguousarray(instance.blocks, dtype=float)
+        w = np.asarray(instance.weights, dtype=float)
+        cells = P.reshape(-1, 2)
+        top = float(w.sum() * np.hypot(*(cells.max(0) - cells.min(0))))  # no two cells lie further apart
+        if instance.closed:
+            return (P, w, np.zeros(0)), n, None, top
+        pen = np.zeros(n)
+        if pinned:
+            pen[:] = 3.0 * top + 1.0
+            pen[pinned] = 0.0
+            top = 3.0 * top + 1.0
+        return (P, w, pen), n + 1, n, top
+    C = (instance.cost + instance.cost.T) / 2
+    if instance.closed:
+        D = np.ascontiguousarray(C)
+    else:
+        penalty = 3.0 * float(np.abs(C).max()) + 1.0
+        D = np.zeros((n + 1, n + 1))
+        D[:n, :n] = C
+        if pinned:
+            D[n, :n] = penalty
+            D[n, pinned] = 0.0
+            D[:n, n] = D[n, :n]
+    return D, len(D), None if instance.closed else n, float(np.abs(D).max())
+
+
+def _cheapest(candidates: np.ndarray, costs: np.ndarray, k: int) -> np.ndarray:
+    """Each row's ``k`` cheapest candidates, cheapest first, ties by index (the same on every machine)."""
+    order = np.lexsort((candidates, costs), axis=1)[:, :k]
+    return np.ascontiguousarray(np.take_along_axis(candidates, order, axis=1), dtype=np.int64)
 
 
 def _neighbour_lists(D: np.ndarray, k: int) -> np.ndarray:
+    """Each node's ``k`` cheapest other nodes in a dense matrix, a block of rows at a time."""
     n = len(D)
     k = min(k, n - 1)
-    masked = D + np.diag(np.full(n, np.inf))
-    part = np.argpartition(masked, k - 1, axis=1)[:, :k] if k < n - 1 else np.argsort(masked, axis=1)[:, :k]
-    costs = np.take_along_axis(masked, part, axis=1)
-    order = np.lexsort((part, costs), axis=1)  # cheapest first, ties by index: the same on every machine
-    return np.ascontiguousarray(np.take_along_axis(part, order, axis=1), dtype=np.int64)
+    out = np.empty((n, k), dtype=np.int64)
+    step = max(1, (1 << 22) // n)  # rows per block: about 32 MB of temporaries
+    for r in range(0, n, step):
+        masked = D[r:r + step].copy()
+        masked[np.arange(len(masked)), np.arange(r, r + len(masked))] = np.inf
+        part = np.argpartition(masked, k - 1, axis=1)[:, :k] if k < n - 1 else np.argsort(masked, axis=1)[:, :k]
+        out[r:r + step] = _cheapest(part, np.take_along_axis(masked, part, axis=1), k)
+    return out
+
+
+def _centres(P: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """The weighted centre of each waypoint's blocks: eq. 2 is at least ``Σw`` times their distance."""
+    return (P * w[None, :, None]).sum(1) / w.sum()
+
+
+def _implicit_neighbour_lists(cm: tuple, dummy: int | None, k: int) -> np.ndarray:
+    """Neighbour lists without a matrix: each waypoint's nearest ``4k`` by the centre of its blocks (a
+    k-d tree; eq. 2 is at least Σw times the centres' distance, so near centres are the likely cheap
+    legs), ranked by eq. 2; the dummy's legs (``pen``) priced as the dense lists would price them."""
+    from scipy.spatial import cKDTree
+
+    P, w, pen = cm
+    n = len(P)
+    m = n + (dummy is not None)
+    k = min(k, m - 1)
+    q = min(n, 4 * k + 1)
+    _, near = cKDTree(_centres(P, w)).query(_centres(P, w), k=q)
+    near = np.asarray(near, dtype=np.int64).reshape(n, q)
+    rows = np.repeat(np.arange(n), q)
+    costs = eq2_legs(P, w, rows, near.ravel()).reshape(n, q)
+    costs[near == np.arange(n)[:, None]] = np.inf
+    if dummy is not None:
+        near = np.hstack([near, np.full((n, 1), dummy)])
+        costs = np.hstack([costs, pen[:, None]])
+    lists = _cheapest(near, costs, k)
+    if dummy is None:
+        return lists
+    mine = np.argsort(pen, kind="stable")[:k][None, :]  # the dummy's own list: its cheapest legs
+    return np.vstack([lists, mine.astype(np.int64)])
+
+
+def _hilbert_tour(cm: tuple, dummy: int | None, first: int) -> np.ndarray:
+    """A tour without a matrix: the waypoints along a Hilbert curve through their block centres, from
+    ``first``, then the dummy (next to ``first`` round the cycle). Its legs are short wherever the
+    waypoints are dense, which is all the local search needs from a start."""
+    xy = _centres(cm[0], cm[1])
+    span = np.maximum(xy.max(0) - xy.min(0), 1e-12)
+    side = 1 << 16
+    x, y = (((xy - xy.min(0)) / span.max()) * (side - 1)).round().astype(np.int64).T
+    d = np.zeros(len(xy), dtype=np.int64)
+    s = side // 2
+    while s > 0:  # the classic xy → Hilbert index, one level at a time
+        rx, ry = (x & s) > 0, (y & s) > 0
+        d += s * s * ((3 * rx) ^ ry)
+        flip = ~ry
+        swap_x = np.where(flip & rx, s - 1 - x, x)
+        swap_y = np.where(flip & rx, s - 1 - y, y)
+        x, y = np.where(flip, swap_y, swap_x), np.where(flip, swap_x, swap_y)
+        s //= 2
+    order = np.argsort(d, kind="stable")
+    order = np.roll(order, -int(np.flatnonzero(order == first)[0]))
+    return order if dummy is None else np.append(order, dummy).astype(np.int64)
 
 
 def _decode(tour: np.ndarray, dummy: int | None, instance: SequencingInstance) -> np.ndarray:
@@ -388,7 +529,8 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     Parameters
     ----------
     instance : SequencingInstance
-        Symmetric costs; an open path (fixed or free start and end) or a closed tour.
+        Symmetric costs, a matrix or implicit eq.-2 costs (memory linear in n); an open path (fixed or
+        free start and end) or a closed tour.
     seed : None, int or numpy.random.Generator
         Seed of the kicks: an int or a Generator gives the same order on every machine (unless the
         time cap stops the search first), None fresh entropy.
@@ -405,8 +547,9 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     -------
     order : ndarray of int64
     info : dict
-        ``engine`` (``"numba"``, or the fallback), ``kicks`` (done), ``improving_kicks``,
-        ``timed_out``, ``initial_cost`` (nearest neighbour, on the closed-tour matrix).
+        ``engine`` (``"numba"``, or the fallback), ``costs`` (``"matrix"`` or implicit), ``kicks``
+        (done), ``improving_kicks``, ``timed_out``, ``initial_cost`` (the start tour, on the closed
+        tour), ``tour_cost``.
 
     Raises
     ------
@@ -436,23 +579,28 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     began = time.perf_counter()
     if not HAVE_NUMBA:
         return _fallback(instance, rng, time_limit)
-    D, dummy = _closed_matrix(instance)
-    m = len(D)
+    cm, m, dummy, top = _cost_model(instance)
     if kicks is None:
         kicks = ils_kicks(m)
     if m < 8:  # every tour through node 0, no kick can help
         from itertools import permutations
 
+        D = np.array([[_d(cm, i, j) for j in range(m)] for i in range(m)]).reshape(m, m)
         tours = np.array([(0, *p) for p in permutations(range(1, m))], dtype=np.int64).reshape(-1, m)
         costs = D[tours, np.roll(tours, -1, axis=1)].sum(axis=1)
         best = tours[int(np.argmin(costs))]
         cost = float(costs.min())
         return _decode(best, dummy, instance), {"engine": "enumeration", "initial_cost": cost, "kicks": 0,
                                                 "improving_kicks": 0, "timed_out": False, "tour_cost": cost}
-    nbr = _neighbour_lists(D, neighbours)
-    tour = _greedy_tour(D).astype(np.int64)
-    info = {"engine": "numba", "initial_cost": float(_tour_cost(D, tour))}
-    eps = 1e-9 * max(1.0, float(np.abs(D).max()))
+    if instance.implicit:
+        nbr = _implicit_neighbour_lists(cm, dummy, neighbours)
+        tour = _hilbert_tour(cm, dummy, 0 if instance.start is None else instance.start)
+    else:
+        nbr = _neighbour_lists(cm, neighbours)
+        tour = _greedy_tour(cm).astype(np.int64)
+    info = {"engine": "numba", "costs": "implicit (eq. 2 on demand)" if instance.implicit else "matrix",
+            "initial_cost": float(_tour_cost(cm, tour))}
+    eps = 1e-9 * max(1.0, top)
     done = kept = 0
     timed_out = False
     # chunks of kicks, each with its own stream draw, so that the cap can stop between them
@@ -460,7 +608,7 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     first = True
     while first or done < kicks:
         step = min(chunk, kicks - done)
-        d, k = _ils(D, nbr, tour, step, ILS_KICK_SPAN, np.uint64((stream + 0x9E37 * done) % 2**64), eps)
+        d, k = _ils(cm, nbr, tour, step, ILS_KICK_SPAN, np.uint64((stream + 0x9E37 * done) % 2**64), eps)
         first = False
         done += d
         kept += k
@@ -469,8 +617,47 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
         if time_limit is not None and time.perf_counter() - began > time_limit and done < kicks:
             timed_out = True
             break
-    info.update(kicks=done, improving_kicks=kept, timed_out=timed_out, tour_cost=float(_tour_cost(D, tour)))
+    info.update(kicks=done, improving_kicks=kept, timed_out=timed_out, tour_cost=float(_tour_cost(cm, tour)))
     return _decode(tour, dummy, instance), info
+
+
+class LocalCore:
+    """The compiled local search (2-opt + Or-opt, neighbour lists, don't-look bits) of ``ils`` on one
+    instance, prepared once (cost model and neighbour lists) for many orders: the memetic GA's local
+    step.
+
+    Examples
+    --------
+    >>> from htetro_opt.problems.waypoint_sequencing import SequencingInstance
+    >>> x = np.array([0.0, 5, 1, 4, 2, 3, 7, 6, 9, 8])
+    >>> core = LocalCore(SequencingInstance.from_matrix(np.abs(np.subtract.outer(x, x)), start=0))
+    >>> core.improve(np.arange(10)).tolist()
+    [0, 2, 4, 5, 3, 1, 7, 6, 9, 8]
+    """
+
+    def __init__(self, instance: SequencingInstance, *, neighbours: int = ILS_NEIGHBOURS) -> None:
+        self.instance = check_instance(instance)
+        if not instance.symmetric:
+            raise ParameterError("the compiled local search assumes a symmetric cost matrix")
+        self.cm, self.m, self.dummy, top = _cost_model(instance)
+        self.eps = 1e-9 * max(1.0, top)
+        self.nbr = None
+        if self.m >= 8 and HAVE_NUMBA:
+            k = check_int(neighbours, "neighbours", minimum=1)
+            self.nbr = (_implicit_neighbour_lists(self.cm, self.dummy, k) if instance.implicit
+                        else _neighbour_lists(self.cm, k))
+
+    def improve(self, order, *, kicks: int = 0, seed: int = 0) -> np.ndarray:
+        """``order`` (a valid order of the instance) improved to a local optimum, after ``kicks``
+        local double-bridge kicks when positive (seeded by ``seed``); unchanged below 8 nodes or
+        without numba."""
+        order = self.instance.check_order(order)
+        if self.nbr is None:
+            return order
+        tour = order if self.dummy is None else np.append(order, self.dummy)
+        tour = np.ascontiguousarray(tour, dtype=np.int64)
+        _ils(self.cm, self.nbr, tour, int(kicks), ILS_KICK_SPAN, np.uint64(seed % 2**64), self.eps)
+        return _decode(tour, self.dummy, self.instance)
 
 
 def _fallback(instance, rng, time_limit):
