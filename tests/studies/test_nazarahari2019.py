@@ -31,6 +31,20 @@ def test_a_small_run_reports_every_section(tmp_path):
     assert md.read_text() == text and table.read_text().count("\n") == 1 + len(run.table2) + len(run.pairs)
 
 
+def test_the_normalised_section_and_the_a_star_note():
+    run = study.run_nazarahari2019(1, maps=("ega04_corridor1",), methods=("A* 1", "A* 0.25"), pairs=(),
+                                   cross4=False, jobs=1)
+    text = study.report(run)
+    assert "Our A* 0.25 equals our A* 1 on 1 of 1 maps" in text and "| EGA linear | 1 |" in text
+    assert {r["method"] for r in run.normalised} == {"EGA linear", "EGA-paper"}
+    exact = run.exact["ega04_corridor1"]
+    for r in run.table2:  # deletion never lengthens a path nor cuts below the optimum
+        assert exact - 1e-9 <= r["smoothed"] <= r["length"] + 1e-9
+    for r in run.normalised:  # the reported terms are the weights times the plan's own measures
+        assert r["terms"][2] == pytest.approx(r["weights"][2] / r["safety"])
+        assert r["single"]["length"] == pytest.approx(exact, rel=1e-6)
+
+
 def test_the_command_line_names_bad_seeds(capsys):
     from htetro_opt.cli import main
 

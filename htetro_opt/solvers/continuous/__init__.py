@@ -8,7 +8,7 @@
   grid baseline;
 - ``"prm"``, ``"rrt"`` and ``"pso"``: the paper's other baselines (:func:`prm_path`: a roadmap of
   exactly n free samples; :func:`rrt_path`: OMPL's RRTConnect, an optional dependency;
-  :func:`pso_path`: pymoo's PSO from the APF's paths), each robot alone;
+  :func:`pso_path`: pymoo's PSO from the APF's paths, every move kept feasible), each robot alone;
 - ``"ega"``, ``"ega-paper"`` and ``"nsga2"``: Nazarahari et al. 2019's enhanced GA over path bases
   (:func:`plan_ega`, :func:`plan_ega_paper`) and pymoo's multi-objective algorithms over the same
   (:func:`plan_moea`), several robots planned jointly;
@@ -30,6 +30,6 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "MOEA_ALGORITHMS": "._ega",
     "prm_path": "._prm", "plan_prm": "._prm", "PAPER_PRM": "._prm",
     "rrt_path": "._rrt", "plan_rrt": "._rrt",
-    "pso_path": "._pso", "plan_pso": "._pso", "pad_path_bases": "._pso",
+    "pso_path": "._pso", "plan_pso": "._pso", "pad_path_bases": "._pso", "keep_feasible_moves": "._pso",
     "apf_depths": "._apf", "apf_paths": "._apf", "apf_population": "._apf", "turning_points": "._apf",
 })

@@ -7,6 +7,7 @@ geometry and measures it: a method cannot report a length or a feasibility its p
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -98,7 +99,8 @@ class ContinuousPlan:
 
     def as_dict(self) -> dict:
         """JSON-ready: ``scenario, method, reached, paths, objectives, min_robot_distance, conflicts,
-        runtime_s, info``."""
+        runtime_s, info`` (a non-finite number in ``info``, such as §5.3's c_R* = ∞, becomes None:
+        strict JSON has no infinity)."""
         return {
             "scenario": self.scenario,
             "method": self.method,
@@ -108,8 +110,19 @@ class ContinuousPlan:
             "min_robot_distance": self.min_robot_distance,
             "conflicts": [list(c) for c in self.conflicts],
             "runtime_s": float(self.runtime_s),
-            "info": dict(self.info),
+            "info": _finite_or_none(dict(self.info)),
         }
+
+
+def _finite_or_none(value):
+    """``value`` with every non-finite float inside its dicts, lists and tuples replaced by None."""
+    if isinstance(value, dict):
+        return {k: _finite_or_none(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite_or_none(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
 
 
 def check_scenario(scenario) -> ContinuousScenario:

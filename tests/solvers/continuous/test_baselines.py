@@ -12,7 +12,8 @@ from htetro_opt.errors import ParameterError
 from htetro_opt.model import ContinuousGeometry, path_length
 from htetro_opt.scenarios import list_scenarios, load_scenario, parse_scenario
 from htetro_opt.solvers import plan_continuous
-from htetro_opt.solvers.continuous import PAPER_PRM, pad_path_bases, prm_path, pso_path, rrt_path
+from htetro_opt.solvers.continuous import (PAPER_PRM, keep_feasible_moves, pad_path_bases, prm_path, pso_path,
+                                          rrt_path)
 
 EGA_MAPS = [n for n in list_scenarios() if n.startswith("ega")]
 WALL = ContinuousGeometry(10, 10, [[4, 0, 6, 8]])
@@ -102,6 +103,35 @@ def test_padding_keeps_the_path_and_pso_never_lengthens_the_best_apf_path():
     history = np.array(info["history"])
     assert len(history) == 21 and np.all(np.diff(history) <= 1e-12)
     assert path_length(path) == pytest.approx(history[-1])
+
+
+def test_feasible_moves_put_back_only_pbs_of_broken_segments_and_leave_every_path_feasible():
+    # oracle: the geometry's own whole-path check, on random moves of feasible paths over the wall
+    rng = np.random.default_rng(3)
+    start, goal = np.array([1.0, 1.0]), np.array([9.0, 1.0])
+    base = np.array([[2.0, 8.5], [4.0, 8.5], [5.0, 9.0], [6.0, 8.5], [8.0, 5.0]])
+    old = (base[None] + rng.uniform(-0.4, 0.4, (300, 5, 2)) * [1, 0]).reshape(300, 10)
+    old = old[[WALL.path_feasible(np.vstack([start, x.reshape(5, 2), goal])) for x in old]]
+    new = old + rng.normal(0, 1.0, old.shape)
+    X, kept = keep_feasible_moves(WALL, start, goal, old, new)
+    X3, old3, new3 = X.reshape(-1, 5, 2), old.reshape(-1, 5, 2), new.reshape(-1, 5, 2)
+    assert len(old) > 100 and np.array_equal(X3[kept], old3[kept]) and np.array_equal(X3[~kept], new3[~kept])
+    feasible_new = np.array([WALL.path_feasible(np.vstack([start, x, goal])) for x in new3])
+    assert not kept[feasible_new].any()  # a feasible move is left alone
+    assert kept[~feasible_new].any(axis=1).all() and 0 < (~feasible_new).sum() < len(new)
+    assert all(WALL.path_feasible(np.vstack([start, x, goal])) for x in X3)
+
+
+@pytest.mark.parametrize("name", ["ega04_corridor1", "ega07_slits1"])
+def test_pso_shortens_its_apf_start(name):
+    # before feasible moves and the d/2 velocity cap no particle ever improved on its APF start here
+    sc = load_scenario(name)
+    exact = plan_continuous(sc).length
+    for seed in range(3):
+        path, info = pso_path(sc.geometry, sc.starts[0], sc.goals[0], seed=seed)
+        history = info["history"]
+        assert history[-1] <= 0.95 * history[0] and history[-1] >= exact - 1e-9
+        assert sc.geometry.path_feasible(path) and path_length(path) == pytest.approx(history[-1])
 
 
 def test_rrt_is_seeded_and_honours_its_time_limit():

@@ -2,6 +2,8 @@
 one seed ⇒ one plan, the four robots of ega_cross4 kept apart, §5.3's normalisation, the NSGA-II
 front, and typed errors."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -77,6 +79,19 @@ def test_normalise_runs_each_term_alone_then_weighs_them():
                                                   optima["length"] / optima["safety_cost"]])
     # the weighted path trades length for smoothness and safety
     assert plan.lengths[0] >= optima["length"] - 1e-9
+    # why §5.3's terms do not balance with eq. 5: its R sums over PBs, and the safety-only run keeps
+    # many more of them than the length-only run (the weighted run's path bases are reported too)
+    length_only, smoothness_only, safety_only = optima["path_bases"]
+    assert safety_only > 2 * length_only and len(plan.info["path_bases"][0]) < safety_only
+
+
+def test_normalise_without_clearance_gives_no_safety_weight():
+    # every APF path touches a wall, so the smallest clearance of the safety-only run's best is 0
+    sc = load_scenario("ega04_corridor1")
+    plan = plan_continuous(sc, method="ega", normalise=True, safety="min", seed=0, max_gen=2)
+    assert plan.info["normalised_from"]["safety_cost"] == float("inf") and plan.info["weights"][2] == 0.0
+    out = json.loads(json.dumps(plan.as_dict(), allow_nan=False))  # strict JSON: no Infinity
+    assert out["info"]["normalised_from"]["safety_cost"] is None
 
 
 def test_weights_change_the_path():
