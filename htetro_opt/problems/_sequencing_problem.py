@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pymoo.core.problem import Problem
 
-from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance, path_cost
+from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance
 
 __all__ = ["SequencingProblem"]
 
@@ -42,4 +42,10 @@ class SequencingProblem(Problem):
         return np.concatenate([head, rest], axis=-1)
 
     def _evaluate(self, x, out, *args, **kwargs):
-        out["F"] = np.atleast_1d(path_cost(self.instance.cost, self.order(x))).reshape(-1, 1)
+        # Through the instance's legs, so an implicit (matrix-free) instance and a closed tour's
+        # return leg are priced as every solver prices them.
+        orders = np.atleast_2d(self.order(x))
+        total = self.instance.legs(orders[:, :-1], orders[:, 1:]).sum(axis=1)
+        if self.instance.closed and orders.shape[1] > 1:
+            total = total + self.instance.legs(orders[:, -1], orders[:, 0])
+        out["F"] = np.asarray(total, dtype=float).reshape(-1, 1)

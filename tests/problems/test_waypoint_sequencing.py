@@ -152,6 +152,22 @@ def test_pymoo_problem_evaluates_path_costs_from_the_fixed_start():
     assert np.allclose(problem.evaluate(perms)[:, 0], [walk(pts.tolist(), o) for o in orders.tolist()])
 
 
+def test_pymoo_problem_prices_a_closed_tour_and_an_implicit_instance_by_hand():
+    rng = np.random.default_rng(4)
+    pts = rng.integers(0, 20, size=(6, 2))
+    blocks = np.repeat(pts[:, None, :], 4, axis=1)
+    perms = np.array([rng.permutation(5) for _ in range(8)])
+    closed = SequencingInstance(cost_matrix(blocks), blocks, start=0, closed=True)
+    problem = SequencingProblem(closed)
+    tours = [o + [o[0]] for o in problem.order(perms).tolist()]  # back to the first waypoint
+    assert np.allclose(problem.evaluate(perms)[:, 0], [walk(pts.tolist(), t) for t in tours])
+    implicit = SequencingInstance(None, blocks, start=0)
+    assert implicit.implicit
+    problem = SequencingProblem(implicit)
+    assert np.allclose(problem.evaluate(perms)[:, 0],
+                       [walk(pts.tolist(), o) for o in problem.order(perms).tolist()])
+
+
 def test_pymoo_ga_runs_on_the_problem_and_its_best_order_is_valid():
     from pymoo.algorithms.soo.nonconvex.ga import GA
     from pymoo.operators.crossover.ox import OrderCrossover
