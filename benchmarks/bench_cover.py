@@ -5,7 +5,9 @@ command adds), completeness, region searches (run / proven optimal / memo hits /
 DAG's size, CPU and wall seconds (one process; the sweep tables are warmed first and timed apart).
 Every plan is re-validated by an independent Simulator replay, and the baseline is asserted to cover
 the same cells. A second table runs every method (stripes, stripes-paper, boustrophedon, tiling-tsp)
-on the 16 x 16 map with the command-driven coverage metrics.
+on the 16 x 16 map with the command-driven coverage metrics; a third sets ``ends="both"`` beside the
+default ``"sweep"`` (asserting it never costs more), and the boustrophedon's mop-up sequenced beside
+nearest-first.
 
     python benchmarks/bench_cover.py            # the issue's targets
     python benchmarks/bench_cover.py --quick    # the 16 x 16 and 16 x 7 rows only
@@ -44,16 +46,16 @@ CASES = [
 LARGE = ("tiling_64x64", "indoor_room")
 
 
-def run(name: str, layers: str, stripes, method: str = "stripes", ends: str = "roadmap") -> dict:
-    """One plan; ``ends``: the roadmap's start and goal ("roadmap"), its start and a free end
-    ("start"), or the bottom-left pose and a free end ("auto")."""
+def run(name: str, layers: str, stripes, method: str = "stripes", where: str = "roadmap", **options) -> dict:
+    """One plan; ``where``: the roadmap's start and goal ("roadmap"), its start and a free end
+    ("start"), or the bottom-left pose and a free end ("auto"); ``options`` go to plan_coverage."""
     sc = load_scenario(name)
     start = goal = None
-    if sc.roadmap and ends != "auto":
+    if sc.roadmap and where != "auto":
         start = sc.start
-        goal = sc.goal if ends == "roadmap" else None
+        goal = sc.goal if where == "roadmap" else None
     cpu, wall = time.process_time(), time.perf_counter()
-    plan = plan_coverage(sc.workspace, layers, method=method, stripes=stripes, start=start, goal=goal)
+    plan = plan_coverage(sc.workspace, layers, method=method, stripes=stripes, start=start, goal=goal, **options)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
     sim = Simulator(sc.workspace, commands=SEED004_COMMANDS)
     replay = sim.run([plan.commands], plan.start)
@@ -79,11 +81,11 @@ def main() -> None:
         if args.quick and name in LARGE:
             continue
         ends = ends[0] if ends else "roadmap"
-        r = run(name, layers, stripes, ends=ends)
+        r = run(name, layers, stripes, where=ends)
         p = r["plan"]
         key = (name, "start" if ends == "roadmap" and name == "indoor_room" else ends)  # O cannot reach its goal
         if key not in baselines:
-            baselines[key] = run(name, "O", 4, method="boustrophedon", ends=key[1])
+            baselines[key] = run(name, "O", 4, method="boustrophedon", where=key[1])
         b = baselines[key]["plan"]
         if p.layers == ("O",):  # the same morphology set from the same start covers the same cells
             assert (b.coverable == p.coverable).all() and not (b.coverable & ~b.covered).any()
@@ -104,6 +106,26 @@ def main() -> None:
             print(f"| {name} | {{{layers}}} | {method} | {'yes' if p.complete else 'no'} | {p.action_cost} "
                   f"| {p.average_coverage_time:.3f} | {p.recovered_pct:.1f} | {p.switches} | {p.turns} "
                   f"| {r['wall']:.2f} |")
+    print("\n| map | S | stripes | cost, ends sweep | cost, ends both | folded stripes | CPU s sweep / both |")
+    print("|---|---|---|---:|---:|---:|---|")
+    for name, layers, stripes in (("coverage_16x16", "O", 4), ("coverage_16x16", "O,vI,hI", 4),
+                                  ("coverage_16x16", "vI,hI", 4), ("coverage_16x16", "O", 3),
+                                  ("coverage_16x7", "O,hI", "2,3,2")):
+        sweep, both = run(name, layers, stripes), run(name, layers, stripes, ends="both")
+        assert both["plan"].action_cost <= sweep["plan"].action_cost
+        folded = sum(d.get("folded", False) for d in both["plan"].stripes_detail)
+        print(f"| {name} | {{{layers}}} | {stripes} | {sweep['plan'].action_cost} | {both['plan'].action_cost} "
+              f"| {folded} | {sweep['cpu']:.2f} / {both['cpu']:.2f} |")
+    print("\n| map (boustrophedon-O) | mop-up nearest-first: commands (mop-up) | sequenced: commands (mop-up) |")
+    print("|---|---:|---:|")
+    for name, ends in (("coverage_16x7", "roadmap"), ("indoor_room", "auto")):
+        if args.quick and name in LARGE:
+            continue
+        near = run(name, "O", 4, method="boustrophedon", where=ends, mopup="nearest")["plan"]
+        seq = run(name, "O", 4, method="boustrophedon", where=ends, mopup="sequenced")["plan"]
+        assert seq.action_cost <= near.action_cost
+        print(f"| {name} ({ends}) | {near.action_cost} ({near.mopup_commands}) "
+              f"| {seq.action_cost} ({seq.mopup_commands}) |")
     print("\nbaseline boustrophedon-O CPU s: "
           + ", ".join(f"{k[0]} ({k[1]}) {v['cpu']:.2f}" for k, v in baselines.items()))
     print(f"total {time.perf_counter() - began:.1f} s")

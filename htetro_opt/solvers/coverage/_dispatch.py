@@ -11,7 +11,14 @@ from htetro_opt.model.workspace import Workspace, check_workspace
 from htetro_opt.solvers.coverage._baselines import boustrophedon_path, tiling_tsp_tokens
 from htetro_opt.solvers.coverage._layers import LayerGraph, parse_layers
 from htetro_opt.solvers.coverage._result import CoveragePlan, check_end, coverability, finish_coverage
-from htetro_opt.solvers.coverage._stripes import mop_up, plan_stripes, shortest_path, stripe_widths
+from htetro_opt.solvers.coverage._stripes import (
+    ENDS,
+    MOPUP_ORDERS,
+    mop_up,
+    plan_stripes,
+    shortest_path,
+    stripe_widths,
+)
 
 __all__ = ["plan_coverage", "COVERAGE_METHODS", "DEFAULT_LAYERS", "auto_start"]
 
@@ -48,7 +55,8 @@ def auto_start(lg: LayerGraph, widths=None):
 
 def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | Callable = "stripes", stripes=4,
                   start=None, goal=None, region_columns: int = 4, budget: int = 20_000, clearance: float = 0.0,
-                  time_limit: float | None = None, memo: bool = True) -> CoveragePlan:
+                  time_limit: float | None = None, memo: bool = True, ends: str = "sweep",
+                  mopup: str = "sequenced") -> CoveragePlan:
     """Plan commands that cover every cell the robot can cover, with one method (Cheng et al. 2019).
 
     Parameters
@@ -91,6 +99,18 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
         Seconds; past them the remaining regions take their greedy walk (``time_limited``). None: no limit.
     memo : bool, keyword-only
         Memoise region searches by their content (True); False gives the same plan, slower.
+    ends : {"sweep", "both"}, keyword-only
+        Stripe methods: where a stripe's sweep may be left. ``"sweep"`` (default, the paper's
+        cut-edges): at its far end, each sweep in the direction the stripes' order gives it.
+        ``"both"``: the start end too; every sweep is in the DAG in both directions, and (default
+        variant) also folded, out for the lower half of its rows and back for the upper half, so
+        that the O in 4-row bands may finish where it began. For one order of the sweeps its DAG
+        is a superset of ``"sweep"``'s, and the plan keeps the cheaper of the two plans with their
+        mop-ups: it never costs more. About four times the work.
+    mopup : {"sequenced", "nearest"}, keyword-only
+        How the cells the sweeps or lanes left are visited: nearest first (the issue's reading of the
+        paper), or ``"sequenced"`` (default): those same vertices re-ordered by 2-opt and Or-opt over
+        the exact leg costs, kept only when cheaper.
 
     Returns
     -------
@@ -103,8 +123,8 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
     UnknownShapeError
         If a layer is not one of the accepted forms.
     ParameterError
-        On an unknown method, stripe widths that are not positive or do not sum to the height,
-        ``region_columns`` or ``budget`` below 1, or a time limit that is not positive.
+        On an unknown method, ``ends`` or ``mopup``, stripe widths that are not positive or do not
+        sum to the height, ``region_columns`` or ``budget`` below 1, or a time limit that is not positive.
     ConfigurationError
         If the start or goal collides, lies off the map or is in a layer outside S.
     PlanningError
@@ -129,6 +149,9 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
     if not callable(method) and method not in COVERAGE_METHODS:
         raise ParameterError(f"unknown coverage method {method!r}: expected one of {', '.join(COVERAGE_METHODS)} "
                              "or a callable")
+    for value, name, choices in ((ends, "ends", ENDS), (mopup, "mopup", MOPUP_ORDERS)):
+        if not isinstance(value, str) or value not in choices:
+            raise ParameterError(f"{name} must be one of {', '.join(choices)}, got {value!r}")
     parsed = parse_layers(layers)
     if method == "boustrophedon":
         parsed = parsed[:1]
@@ -160,19 +183,19 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
     if method in ("stripes", "stripes-paper"):
         deadline = None if time_limit is None else began + time_limit
         outcome = plan_stripes(lg, cov, start_node, goal_node, widths, region_columns=region_columns, budget=budget,
-                               deadline=deadline, memo=memo, paper=method == "stripes-paper")
+                               deadline=deadline, memo=memo, paper=method == "stripes-paper", ends=ends, mopup=mopup)
         path = outcome.path
         extras = {"stripes_detail": tuple(outcome.stripes), "regions": outcome.regions,
                   "regions_optimal": outcome.regions_optimal, "memo_hits": outcome.memo_hits,
                   "nodes": outcome.nodes, "dag_cost": outcome.dag_cost, "time_limited": outcome.time_limited,
-                  "info": outcome.info}
+                  "info": outcome.info, "ends": ends}
         used_stripes = widths
     else:
         path = boustrophedon_path(lg, start_node, cov.reachable)
         extras = {"info": {}}
         used_stripes = ()
     lanes = len(path) - 1
-    added = mop_up(lg, path, cov.coverable, cov.reachable)
+    added = mop_up(lg, path, cov.coverable, cov.reachable, order=mopup, goal=goal_node)
     mopup_path = [path[-1]] + added
     tail = []
     if goal_node is not None and mopup_path[-1] != goal_node:

@@ -68,8 +68,8 @@ class CoveragePlan:
     stripes_detail : tuple of dict
         Per stripe: ``rows`` (its own, [low, high)), ``band`` (with the rows borrowed by widening,
         [low, high)), ``borrowed`` (their number), ``cost`` (commands of the plan's part in it),
-        ``regions``, ``direction`` (+1: swept +x) and ``cuts`` (x of the cell edges between its
-        regions, each at x − ½).
+        ``regions``, ``direction`` (+1: swept +x), ``folded`` (swept out and back, ``ends="both"``)
+        and ``cuts`` (x of the cell edges between its regions, each at x − ½).
     regions, regions_optimal, memo_hits, nodes : int
         Region searches run (memo hits excluded), those proven optimal, memo hits, search nodes expanded.
     dag_cost : int or None
@@ -81,6 +81,8 @@ class CoveragePlan:
         stripes left uncovered.
     time_limited : bool
         The time limit cut the search short (the plan is still complete and valid).
+    ends : str or None
+        The stripe methods' ``ends`` option (``"sweep"`` or ``"both"``); None for the other methods.
     runtime_s : float
     info : dict
         Method-specific extras (JSON-ready).
@@ -115,6 +117,7 @@ class CoveragePlan:
     mopup_commands: int = 0
     switches: int = 0
     time_limited: bool = False
+    ends: str | None = None
     runtime_s: float = 0.0
     info: Mapping = field(default_factory=dict)
 
@@ -210,6 +213,7 @@ class CoveragePlan:
             "mopup_commands": self.mopup_commands,
             "stripes_detail": [dict(d) for d in self.stripes_detail],
             "time_limited": self.time_limited,
+            "ends": self.ends,
             "runtime_s": self.runtime_s,
         }
 

@@ -14,7 +14,9 @@ Our reading of the paper, where it is ambiguous or contradicts itself:
   where they exist). The sweeps are taken greedily, each the one whose entry is nearest the last
   one's exit, in either direction (ties: the lower stripe, the direction opposite to the last): on a
   map without splits this is the paper's boustrophedon of stripes (+x, −x, …); a room behind a
-  doorway is covered whole before the robot goes back through it.
+  doorway is covered whole before the robot goes back through it. Up to :data:`ORDER_SWEEPS`
+  sweeps, the default variant then improves that order by moving or reversing one sweep at a time
+  while the whole DAG's cost drops (coverage_16x16 {vI, hI}: 190 → 173 commands).
 - **Widening** (Alg. 5 l. 14): when some of a stripe's targets lie under no vertex of its band, rows
   are borrowed one at a time, the previous stripe's first, at most as many as the stripe has (the
   band that leaves fewest out wins, then the narrowest). The paper also widens a stripe whose exit
@@ -22,8 +24,12 @@ Our reading of the paper, where it is ambiguous or contradicts itself:
   split stripes swept piece by piece or widened, and keeps the cheaper plan (:func:`plan_stripes`).
   A sweep's targets stay its own rows' cells.
 - **Ports and joins** (Def. 8–9): per piece and layer, the vertices at the sweep's x end with the
-  lowest and the highest y are its ports (entry at the start end, exit at the far end).
-- **Regions** (§IV-B): each sweep is cut every ``region_columns`` columns along its direction; the
+  lowest and the highest y are its ports (entry at the start end, exit at the far end). With
+  ``ends="both"`` every sweep may be left at either end: the DAG holds it in both directions and,
+  in the default variant, folded (out for the lower half of its rows, back for the upper half), so
+  an O in a 4-row band may finish where it began.
+- **Regions** (§IV-B): each sweep is cut every ``region_columns`` columns along its direction, on
+  two staggered grids (:data:`CUT_OFFSETS`), each a chain of the DAG between the sweep's ports; the
   ports at a cut are the sweep's vertices with B2 in the cut column (a cut without any is dropped).
   A region may use the sweep's vertices with B2 up to 3 columns outside it and must cover the targets
   in its columns reachable from its entry in that window; the rest is left to the mop-up.
@@ -35,8 +41,9 @@ Our reading of the paper, where it is ambiguous or contradicts itself:
 - **Start, goal, mop-up**: the first sweep is in the lowest stripe (the one holding the start, else
   the nearest); a start outside it reaches its entry ports (a goal outside the last sweep is reached
   from its exit ports) by shortest paths; without a goal the plan ends where the last region does.
-  Cells the sweeps leave uncovered are visited nearest-first afterwards (mop-up), and the plan then
-  returns to the goal if there is one. If the DAG has no path at all, the whole map is covered by the
+  Cells the sweeps leave uncovered are visited afterwards (mop-up: nearest-first, then re-ordered by
+  2-opt and Or-opt over exact leg costs when that is cheaper), and the plan then returns to the goal
+  if there is one. If the DAG has no path at all, the whole map is covered by the
   mop-up walk from the start.
 """
 
@@ -56,10 +63,37 @@ from htetro_opt.solvers.coverage._layers import LayerGraph
 from htetro_opt.solvers.coverage._rbt import Region, greedy_walk, search_inserting, search_region
 from htetro_opt.solvers.coverage._result import Coverability
 
-__all__ = ["stripe_widths", "plan_stripes", "StripeOutcome", "shortest_path", "mop_up", "WINDOW_MARGIN"]
+__all__ = ["stripe_widths", "plan_stripes", "StripeOutcome", "shortest_path", "mop_up", "WINDOW_MARGIN", "CUT_OFFSETS",
+           "ENDS", "MOPUP_ORDERS"]
 
 WINDOW_MARGIN = 3
 """Columns a region may use beyond its own on either side (B2's column)."""
+
+CUT_OFFSETS = (0.0, 0.5)
+"""The default variant's cut grids, as fractions of ``region_columns``: cuts every
+``region_columns`` columns from the sweep's start, and that grid shifted by half a region. Both are
+chains of the DAG between the sweep's ports, so each sweep takes the cheaper (a superset of one grid:
+the DAG's path never costs more); a cut that happens to fall across a sweep's cheapest turn costs
+commands (coverage_16x7, {O, hI}: 90 with one grid, 88 with both; indoor_room, {O, vI, hI}: 4,832
+and 4,810), for about twice the region searches."""
+
+ORDER_SWEEPS = 12
+"""Up to this many sweeps, the greedy order of the sweeps is improved by moves checked on the whole
+DAG (:meth:`_Planner._improve_order`); beyond, each try's DAG solve costs too much and the greedy
+order stands (on a map without splits it is the boustrophedon of stripes)."""
+
+ORDER_TRIES = 300
+"""DAG solves the order's improvement may spend."""
+
+DROP_PENALTY = 1_000_000
+"""DAG weight of a target a region leaves to the mop-up (it cannot reach it in its window from its
+entry): more than any plan's commands, so the DAG's path leaves as few as it can and only then
+costs least. Without it, a chain that skips targets looks cheaper than it is (coverage_16x7 in one
+7-row stripe, {O, hI}: 71 commands of DAG path, then 15 of mop-up, against 78 covering all)."""
+
+ENDS = ("sweep", "both")
+"""Where a sweep may be left (:func:`plan_stripes`'s ``ends``): at its far end only ("sweep"), or at
+either end ("both": every sweep is in the DAG in both directions)."""
 
 
 def stripe_widths(stripes, height: int, name: str = "stripes") -> tuple[int, ...]:
@@ -104,9 +138,11 @@ class _Sweep:
     nodes: np.ndarray  # their union
     targets: np.ndarray  # flat coverable cells of the stripe's own rows this sweep must cover
     direction: int = 1  # +1: sweep +x, −1: −x
-    blocks: list = field(default_factory=list)  # region columns [c0, c1) in sweep order
+    blocks: list = field(default_factory=list)  # region columns [c0, c1) in sweep order (the plan's layout)
     cuts: list = field(default_factory=list)  # ports (vertices) at each cut between blocks
+    layouts: dict = field(default_factory=dict)  # (direction, offset, fold) -> (blocks, cuts, passes): the DAG's chains
     cost: int = 0
+    folded: bool = False  # the DAG's path takes the folded chain (out and back, ``ends="both"``)
     key: int = 0  # unique per sweep: region searches are cached by it
 
 
@@ -141,14 +177,16 @@ def _walk_back(pred, source: int, target: int) -> list[int]:
     return path[::-1]
 
 
-def mop_up(lg: LayerGraph, path: list[int], coverable: np.ndarray, reachable: np.ndarray) -> list[int]:
-    """Extend a vertex path until every coverable cell is under a visited footprint: each time to the
-    nearest vertex covering an uncovered cell (ties: the lower vertex number)."""
-    hw = lg.width * lg.height
-    covered = np.zeros(hw, dtype=bool)
-    covered[lg.footprint[path].ravel()] = True
-    target = coverable.reshape(-1)
+MOPUP_ORDERS = ("sequenced", "nearest")
+"""How the mop-up orders the cells the sweeps left (:func:`mop_up`)."""
+
+
+def _nearest_first(lg: LayerGraph, path: list[int], target: np.ndarray, reachable: np.ndarray,
+                   covered: np.ndarray) -> tuple[list[int], list[int]]:
+    """Extend from ``path[-1]``: each time to the nearest vertex covering an uncovered target cell
+    (ties: the lower vertex number). Returns (the added vertices, the vertices gone to). Updates ``covered``."""
     added: list[int] = []
+    goals: list[int] = []
     cur = path[-1]
     while (target & ~covered).any():
         useful = reachable & (target & ~covered)[lg.footprint].any(axis=1)
@@ -160,15 +198,62 @@ def mop_up(lg: LayerGraph, path: list[int], coverable: np.ndarray, reachable: np
         leg = _walk_back(pred, cur, goal)[1:]
         covered[lg.footprint[leg].ravel()] = True
         added += leg
+        goals.append(goal)
         cur = goal
-    return added
+    return added, goals
+
+
+def mop_up(lg: LayerGraph, path: list[int], coverable: np.ndarray, reachable: np.ndarray, *,
+           order: str = "sequenced", goal: int | None = None) -> list[int]:
+    """Extend a vertex path until every coverable cell is under a visited footprint.
+
+    ``"nearest"``: each time to the nearest vertex covering an uncovered cell (ties: the lower
+    vertex number). ``"sequenced"`` (the default): the vertices that walk goes to, re-ordered as an
+    open path from ``path[-1]`` by 2-opt and Or-opt over the exact leg costs between them
+    (:func:`~htetro_opt.solvers.sequencing.improve`, deterministic, from the nearest-first order),
+    driven by shortest legs, skipping a vertex whose cells are covered by then and finishing
+    nearest-first if the new legs left a cell; the cheaper of the two walks is kept, counting the
+    return to ``goal`` if there is one (ties: the nearest-first one), so the sequenced mop-up never
+    costs more."""
+    target = coverable.reshape(-1)
+    base = np.zeros(lg.width * lg.height, dtype=bool)
+    base[lg.footprint[path].ravel()] = True
+    added, goals = _nearest_first(lg, path, target, reachable, base.copy())
+    if order == "nearest" or len(goals) < 3:  # two waypoints have one order from a fixed start
+        return added
+    nodes = [path[-1]] + goals
+    legs = dijkstra(lg.matrix, indices=nodes)[:, nodes]
+    from htetro_opt.solvers.sequencing import improve
+
+    better = improve(np.maximum(legs, legs.T), np.arange(len(nodes)), fixed_start=True)
+    if better.tolist() == list(range(len(nodes))):
+        return added
+    covered, cur, walk = base.copy(), path[-1], []
+    for i in better.tolist()[1:]:
+        goal = nodes[i]
+        if not (target & ~covered)[lg.footprint[goal]].any():
+            continue
+        _, leg = shortest_path(lg, cur, goal)
+        covered[lg.footprint[leg].ravel()] = True
+        walk += leg[1:]
+        cur = goal
+    rest, _ = _nearest_first(lg, [cur], target, reachable, covered)
+    walk += rest
+    def cost(w: list[int]) -> float:
+        end = ([path[-1]] + w)[-1]
+        back = 0.0 if goal is None else shortest_path(lg, end, goal)[0]
+        return len(lg.commands_of([path[-1]] + w)) + back
+
+    return walk if cost(walk) < cost(added) else added
 
 
 class _Planner:
     def __init__(self, lg: LayerGraph, cov: Coverability, start: int, goal: int | None, widths, *,
                  region_columns: int, budget: int, deadline: float | None, memo: bool, paper: bool = False,
-                 widening: str = "split") -> None:
-        self.lg, self.cov, self.start, self.goal, self.paper = lg, cov, start, goal, paper
+                 widening: str = "split", ends: str = "sweep", shared_memo: dict | None = None,
+                 mopup: str = "sequenced") -> None:
+        self.lg, self.cov, self.start, self.goal, self.paper, self.ends = lg, cov, start, goal, paper, ends
+        self.mopup = mopup
         self.region_columns, self.budget, self.deadline, self.use_memo = region_columns, budget, deadline, memo
         n = lg.n_nodes
         ids = np.arange(n)
@@ -177,7 +262,8 @@ class _Planner:
         self.ylo, self.yhi = lg.rows
         self.reach = cov.reachable
         self.coverable = cov.coverable.reshape(-1)
-        self.memo: dict = {}
+        self.memo: dict = {} if shared_memo is None else shared_memo  # keyed by content: safe to share
+        self._from: dict | None = None  # shortest paths from a port, (dist, pred), kept while the order is improved
         self.problems: dict = {}
         self.results: dict = {}
         self.stats = {"regions": 0, "optimal": 0, "memo_hits": 0, "nodes": 0}
@@ -279,25 +365,6 @@ class _Planner:
             return [joined]
         return [best[1:], joined]
 
-    def _cheaper(self, options: list):
-        """Of a stripe's candidate (band, sweeps), the one whose sweeps cost least alone (swept +x in
-        x order, either way, any port in and out: the same DAG and region searches as the plan's;
-        ties: the first, the split stripe, whose pieces the plan may order as it goes)."""
-        best = None
-        for band, sweeps in options:
-            cost = math.inf
-            for direction in (1, -1):
-                for sweep in sweeps:
-                    sweep.direction = direction
-                    self._regions(sweep)
-                chain = sorted(sweeps, key=lambda sw: -direction * int(self.bx[sw.nodes].max()))[::-1]
-                found, _ = self._solve(self.dag(chain, start=None, goal=None))
-                cost = min(cost, math.inf if found is None else found)
-            if best is None or cost < best[0]:
-                best = (cost, band, sweeps)
-        self.choices["widened" if best[2] is options[-1][1] else "split"] += 1
-        return best[1], best[2]
-
     def _forced(self, sweep: _Sweep) -> np.ndarray:
         """The sweep's forced poses: the only vertex of the sweep covering some target."""
         hw = self.lg.width * self.lg.height
@@ -308,23 +375,62 @@ class _Planner:
         lonely = hits.sum(axis=0) == 1
         return sweep.nodes[np.flatnonzero(hits[:, lonely].any(axis=1))]
 
+    def _offsets(self) -> tuple[int, ...]:
+        """Offsets of the default variant's cut grids: every ``region_columns`` columns from the
+        sweep's start, and the same grid shifted by half a region (:data:`CUT_OFFSETS`)."""
+        rc = self.region_columns
+        return tuple(dict.fromkeys(min(rc - 1, int(f * rc)) for f in CUT_OFFSETS))
+
     def _regions(self, sweep: _Sweep) -> None:
+        """The sweep's chains for the DAG (``sweep.layouts``), keyed ``(direction, offset, fold)``.
+
+        Per direction (the sweep's own; both with ``ends="both"``) and cut grid (the paper's: forced
+        poses; ours: every ``region_columns`` columns, at each offset of :meth:`_offsets`), a
+        straight chain (fold 0) runs from the start end to the far end. With ``ends="both"`` the
+        default variant adds a folded chain (fold 1) that ends where it began: out along the
+        direction for the lower half of the stripe's own rows, back for the upper half, turning at
+        the far end's vertices (the O in a 4-row band, one lane out and one back). Each value is
+        (region columns in chain order, ports at each cut, per region (direction, own rows it must
+        cover)). ``sweep.blocks``/``cuts`` start as the first chain's and become the DAG path's."""
+        directions = (sweep.direction,) if self.ends == "sweep" else (sweep.direction, -sweep.direction)
+        lo, hi = sweep.own
+        mid = lo + (hi - lo + 1) // 2
+        sweep.layouts = {}
+        for d in directions:
+            for offset in ((0,) if self.paper else self._offsets()):
+                blocks, cuts = self._layout(sweep, d, offset)
+                chain = (blocks, cuts, [(d, (lo, hi))] * len(blocks))
+                if not any(_same_chain(chain, other) for other in sweep.layouts.values()):
+                    sweep.layouts[(d, offset, 0)] = chain  # a narrow sweep may give one chain twice
+                if self.ends == "sweep" or self.paper or mid >= hi:
+                    continue
+                turn = np.array(self._ports(sweep, d, every=True), dtype=np.int64)
+                back, back_cuts = self._layout(sweep, -d, offset)
+                sweep.layouts[(d, offset, 1)] = (blocks + back, cuts + [turn] + back_cuts,
+                                                  [(d, (lo, mid))] * len(blocks) + [(-d, (mid, hi))] * len(back))
+        sweep.blocks, sweep.cuts = next(iter(sweep.layouts.values()))[:2]
+
+    def _layout(self, sweep: _Sweep, direction: int, offset: int) -> tuple[list, list]:
+        """Region columns [c0, c1) in sweep order and the ports at each cut, for one direction and
+        (default variant) one cut grid: cuts at ``offset``, ``offset + region_columns``, … columns
+        from the sweep's start."""
         w, rc = self.lg.width, self.region_columns
         forced = self._forced(sweep) if self.paper else None
         if self.paper:  # cut only at forced poses: blocks start at their columns, along the sweep
             edges = [c for c in sorted(set(self.bx[forced].tolist())) if 0 < c < w]
-            if sweep.direction < 0:
+            if direction < 0:
                 edges = [c + 1 for c in edges if c + 1 < w]
             bounds = [0] + sorted(set(edges)) + [w]
             blocks = [(a, b) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
         else:
-            blocks = [(c, min(c + rc, w)) for c in range(0, w, rc)]
-        if sweep.direction < 0:
+            bounds = sorted({0, w} | set(range(offset, w, rc)))
+            blocks = [(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+        if direction < 0:
             blocks = blocks[::-1] if self.paper else [(w - c1, w - c0) for c0, c1 in blocks]
         bx = self.bx[sweep.nodes]
         merged, cuts = [blocks[0]], []
         for block in blocks[1:]:
-            column = block[0] if sweep.direction > 0 else block[1] - 1
+            column = block[0] if direction > 0 else block[1] - 1
             ports = sweep.nodes[bx == column]
             if self.paper:
                 ports = ports[np.isin(ports, forced)]
@@ -334,16 +440,21 @@ class _Planner:
             else:  # no vertex to cut at: this block joins the previous one
                 c0, c1 = merged[-1]
                 merged[-1] = (min(c0, block[0]), max(c1, block[1]))
-        sweep.blocks, sweep.cuts = merged, cuts
+        return merged, cuts
 
-    def _ports(self, sweep: _Sweep, end: int, toward: tuple[int, ...] = (-1, 1)) -> list[int]:
+    def _ports(self, sweep: _Sweep, end: int, toward: tuple[int, ...] = (-1, 1), every: bool = False) -> list[int]:
         """Per piece and layer, the vertices at the x end ``end`` (+1: max x) with the y extremes
-        ``toward`` (+1: max y): the ports a sweep is entered or left by."""
+        ``toward`` (+1: max y): the ports a sweep is entered or left by (``every``: all the
+        vertices at that x, a folded chain's turn)."""
         hw = self.lg.width * self.lg.height
         ports = []
         for piece in sweep.pieces:
             for layer in range(self.lg.n_layers):
                 nodes = piece[piece // hw == layer]
+                if every and len(nodes):
+                    far = (end * self.bx[nodes]).max()
+                    ports += sorted(nodes[end * self.bx[nodes] == far].tolist())
+                    continue
                 for t in toward:
                     if len(nodes):
                         key = np.lexsort((-t * self.by[nodes], -end * self.bx[nodes]))
@@ -390,13 +501,15 @@ class _Planner:
         return keep, self.lg.matrix[keep][:, keep]
 
     # --- regions ------------------------------------------------------------------------------
-    def _problem(self, stripe: _Sweep, b: int, entry: int, exits: list[int]):
-        """The region problem of block b of a sweep from ``entry``: (nodes, Region, memo key)."""
-        key = (stripe.key, stripe.direction, b, entry)
+    def _problem(self, stripe: _Sweep, layout: tuple[int, int], b: int, entry: int, exits: list[int]):
+        """The region problem of block b of a sweep's chain ``layout`` from ``entry``: (nodes, Region,
+        memo key)."""
+        key = (stripe.key, layout, b, entry)
+        direction, (r0, r1) = stripe.layouts[layout][2][b]
         if key in self.problems:
             return self.problems[key]
         lg = self.lg
-        c0, c1 = stripe.blocks[b]
+        c0, c1 = stripe.layouts[layout][0][b]
         xs = [self.bx[entry]] + [self.bx[e] for e in exits if e >= 0]
         margin = lg.width if self.paper else WINDOW_MARGIN  # the paper's regions: the whole stripe
         x0 = min(c0, *xs) - margin
@@ -410,8 +523,8 @@ class _Planner:
         nodes = nodes[labels == labels[at]]
         sub = lg.matrix[nodes][:, nodes].tocsr()
         sub.sort_indices()
-        tx = stripe.targets % lg.width
-        targets = stripe.targets[(tx >= c0) & (tx < c1)]
+        tx, ty = stripe.targets % lg.width, stripe.targets // lg.width
+        targets = stripe.targets[(tx >= c0) & (tx < c1) & (ty >= r0) & (ty < r1)]
         fp = lg.footprint[nodes]  # (V, 4)
         reachable_targets = targets[np.isin(targets, fp)]
         bit_of = {int(c): t for t, c in enumerate(reachable_targets.tolist())}  # sorted by (y, x)
@@ -421,23 +534,26 @@ class _Planner:
         band_lo = stripe.band[0]
         rel = (nodes // (lg.width * lg.height)) * 10**6 + (self.by[nodes] - band_lo) * width + (self.bx[nodes] - x0)
         memo_key = (width, rel.tobytes(), sub.indptr.tobytes(), sub.indices.tobytes(), sub.data.tobytes(), bits,
-                    stripe.direction if self.paper else 0)  # the paper's search orders its moves by the sweep
+                    direction if self.paper else 0)  # the paper's search orders its moves by the sweep
         dist, pred = dijkstra(sub, return_predecessors=True)
         adjacency = tuple(
             tuple(zip(sub.indices[sub.indptr[v]:sub.indptr[v + 1]].tolist(),
                       sub.data[sub.indptr[v]:sub.indptr[v + 1]].astype(int).tolist()))
             for v in range(len(nodes)))
-        progress = tuple((stripe.direction * self.bx[nodes]).tolist())
-        target_progress = tuple((stripe.direction * (reachable_targets % lg.width)).tolist())
+        progress = tuple((direction * self.bx[nodes]).tolist())
+        target_progress = tuple((direction * (reachable_targets % lg.width)).tolist())
         region = Region(adjacency, bits, full, dist, pred, progress, target_progress)
-        self.problems[key] = (nodes, region, memo_key)
+        self.problems[key] = (nodes, region, memo_key, len(targets) - len(reachable_targets))
         return self.problems[key]
 
-    def region_cost(self, sweep: _Sweep, b: int, entry: int, exit: int, exits: list[int]) -> float | None:
-        """Cost of block b of a sweep from entry to exit (−1: a free end), None if impossible."""
-        key = (sweep.key, sweep.direction, b, entry, exit)
+    def region_cost(self, sweep: _Sweep, layout: tuple[int, int], b: int, entry: int, exit: int,
+                    exits: list[int]) -> float | None:
+        """DAG weight of block b of a sweep's chain ``layout`` from entry to exit (−1: a free end):
+        its search's cost plus :data:`DROP_PENALTY` per target of its columns it cannot reach in its
+        window from that entry (left to the mop-up); None if impossible."""
+        key = (sweep.key, layout, b, entry, exit)
         if key not in self.results:
-            nodes, region, memo_key = self._problem(sweep, b, entry, exits)
+            nodes, region, memo_key, dropped = self._problem(sweep, layout, b, entry, exits)
             local = {int(v): i for i, v in enumerate(nodes)}
             if exit >= 0 and exit not in local:
                 self.results[key] = None
@@ -459,9 +575,10 @@ class _Planner:
                     self.stats["optimal"] += bool(result.optimal)
                     self.stats["nodes"] += result.nodes
                 self.memo[full_key] = result
-            self.results[key] = None if result is None else (result.cost, [int(nodes[v]) for v in result.path])
+            self.results[key] = None if result is None else (result.cost, [int(nodes[v]) for v in result.path],
+                                                             dropped)
         found = self.results[key]
-        return None if found is None else found[0]
+        return None if found is None else found[0] + DROP_PENALTY * found[2]
 
     # --- the DAG ------------------------------------------------------------------------------
     def _legs(self, g: nx.DiGraph, outs: list[int], intos: list[int], tail, head, a=None, b=None) -> list[int]:
@@ -489,98 +606,190 @@ class _Planner:
             if reached:
                 return list(dict.fromkeys(reached))
         for out in outs:
-            dist, pred = dijkstra(self.lg.matrix, indices=out, return_predecessors=True)
+            if self._from is None:
+                dist, pred = dijkstra(self.lg.matrix, indices=out, return_predecessors=True)
+            else:  # the order's improvement builds many DAGs over the same ports
+                if out not in self._from:
+                    self._from[out] = dijkstra(self.lg.matrix, indices=out, return_predecessors=True)
+                dist, pred = self._from[out]
             for into in intos:
-                if math.isfinite(dist[into]):
-                    g.add_edge(tail(out), head(into), kind="fixed", cost=dist[into],
-                               path=_walk_back(pred, out, into))
+                if math.isfinite(dist[into]):  # the leg's vertices are walked back only if the path takes it
+                    g.add_edge(tail(out), head(into), kind="fixed", cost=dist[into], pred=(pred, out, into))
                     reached.append(into)
         return list(dict.fromkeys(reached))
 
+    @staticmethod
+    def _exit_side(layout: tuple[int, int, int]) -> int:
+        """The x end a chain leaves its sweep by: the far end (+1: max x), or for a folded chain the one it began at."""
+        return -layout[0] if layout[2] else layout[0]
+
+    def _end_ports(self, sweep: _Sweep, side: int) -> list[int]:
+        """The entry ports (side −1) or exit ports (side +1) of every chain of a sweep."""
+        ends = dict.fromkeys(-k[0] if side < 0 else self._exit_side(k) for k in sweep.layouts)
+        return list(dict.fromkeys(v for e in ends for v in self._ports(sweep, e)))
+
     def dag(self, chain: list[_Sweep], *, start: int | None, goal) -> nx.DiGraph:
         """The auxiliary DAG of a chain of sweeps: "S" (the start vertex, or every entry port of the
-        first sweep at no cost when None), ports, cuts and joins, then "G" (the goal vertex, or a free
-        end when None)."""
+        first sweep at no cost when None); per sweep s its entry ports ``("in", s, v)``, the ports at
+        the cuts of each of its chains ``(s, layout, b, v)`` and its exit ports ``("out", s, v)``
+        (v = −1: a free end); then "G" (the goal vertex, or a free end when None). A sweep's chains
+        (its cut grids and, with ``ends="both"``, both directions) run in parallel between its ports."""
         g = nx.DiGraph()
         last = len(chain) - 1
         first = chain[0]
+        start_inside = start is not None and start in set(first.nodes.tolist())
         if start is None:
-            entries = self._ports(first, -first.direction)
-            for v in entries:
-                g.add_edge("S", (0, -1, v), kind="fixed", cost=0, path=[v])
-        elif start in set(first.nodes.tolist()):
-            entries = [start]
-            g.add_edge("S", (0, -1, start), kind="fixed", cost=0, path=[start])
+            for v in self._end_ports(first, -1):
+                g.add_edge("S", ("in", 0, v), kind="fixed", cost=0, path=[v])
+        elif start_inside:
+            g.add_edge("S", ("in", 0, start), kind="fixed", cost=0, path=[start])
         else:
-            entries = self._legs(g, [start], self._ports(first, -first.direction), lambda v: "S",
-                                 lambda v: (0, -1, v))
+            self._legs(g, [start], self._end_ports(first, -1), lambda v: "S", lambda v: ("in", 0, v))
         for s, sweep in enumerate(chain):
-            levels = [entries] + [c.tolist() for c in sweep.cuts]
-            end = len(levels) - 1
+            goal_inside = s == last and goal is not None and goal in set(sweep.nodes.tolist())
             if s < last:
                 nxt = chain[s + 1]
-                outs = self._ports(sweep, sweep.direction)
-                entries = self._legs(g, outs, self._ports(nxt, -nxt.direction), lambda v: (s, end, v),
-                                     lambda v: (s + 1, -1, v), sweep, nxt)
-                exits = [v for v in outs if g.has_node((s, end, v))]
+                self._legs(g, self._end_ports(sweep, 1), self._end_ports(nxt, -1), lambda v: ("out", s, v),
+                           lambda v: ("in", s + 1, v), sweep, nxt)
             elif goal is None:
-                exits = [-1]
-                g.add_edge((s, end, -1), "G", kind="fixed", cost=0, path=[])
-            elif goal in set(sweep.nodes.tolist()):
-                exits = [goal]
-                g.add_edge((s, end, goal), "G", kind="fixed", cost=0, path=[goal])
+                g.add_edge(("out", s, -1), "G", kind="fixed", cost=0, path=[])
+            elif goal_inside:
+                g.add_edge(("out", s, goal), "G", kind="fixed", cost=0, path=[goal])
             else:
-                outs = self._ports(sweep, sweep.direction)
-                self._legs(g, outs, [goal], lambda v: (s, end, v), lambda v: "G")
-                exits = [v for v in outs if g.has_node((s, end, v))]
-            levels.append(exits)
-            for b in range(len(sweep.blocks)):
-                for p in levels[b]:
-                    for q in levels[b + 1]:
-                        g.add_edge((s, b - 1, p), (s, b, q), kind="region", sweep=sweep, block=b,
-                                   exits=levels[b + 1])
+                self._legs(g, self._end_ports(sweep, 1), [goal], lambda v: ("out", s, v), lambda v: "G")
+            for layout, (blocks, cuts, _) in sweep.layouts.items():
+                d = layout[0]
+                if s == 0 and start_inside:
+                    entries = [start]
+                else:
+                    entries = [v for v in self._ports(sweep, -d) if g.has_node(("in", s, v))]
+                if s == last and goal is None:
+                    exits = [-1]
+                elif goal_inside:
+                    exits = [goal]
+                else:
+                    exits = [v for v in self._ports(sweep, self._exit_side(layout)) if g.has_node(("out", s, v))]
+                levels = [entries] + [c.tolist() for c in cuts] + [exits]
+                end = len(levels) - 1
+
+                def name(i: int, v: int, s=s, layout=layout, end=end):
+                    return ("out", s, v) if i == end else (s, layout, i, v)
+
+                for p in entries:  # each chain its own first node: one-region chains would share an edge
+                    g.add_edge(("in", s, p), name(0, p), kind="fixed", cost=0, path=[p])
+                for b in range(len(blocks)):
+                    for p in levels[b]:
+                        for q in levels[b + 1]:
+                            g.add_edge(name(b, p), name(b + 1, q), kind="region", sweep=sweep, layout=layout,
+                                       block=b, exits=levels[b + 1])
         return g
 
     def _solve(self, g: nx.DiGraph):
         """(cost, node path) of the DAG's shortest S → G path, region costs computed lazily; (None, None)
-        if there is none."""
+        if there is none. The cost is in commands: the path's weight without the penalties for
+        targets left to the mop-up."""
         def weight(u, v, data):
             if data["kind"] == "fixed":
                 return data["cost"]
-            return self.region_cost(data["sweep"], data["block"], u[2], v[2], data["exits"])
+            return self.region_cost(data["sweep"], data["layout"], data["block"], u[-1], v[-1], data["exits"])
 
         if "S" not in g or "G" not in g:
             return None, None
         try:
-            return nx.single_source_dijkstra(g, "S", "G", weight=weight)
+            weighted, path = nx.single_source_dijkstra(g, "S", "G", weight=weight)
         except nx.NetworkXNoPath:
             return None, None
+        return weighted - DROP_PENALTY * self._dropped(g, path), path
+
+    def _dropped(self, g: nx.DiGraph, path: list) -> int:
+        """Targets the regions along a DAG path leave to the mop-up."""
+        return sum(self.results[(d["sweep"].key, d["layout"], d["block"], u[-1], v[-1])][2]
+                   for u, v, d in ((u, v, g.edges[u, v]) for u, v in zip(path[:-1], path[1:])) if d["kind"] == "region")
+
+    def _improve_order(self) -> int:
+        """Improve the greedy order of the sweeps (default variant, at most :data:`ORDER_SWEEPS`
+        sweeps): move one sweep elsewhere in the chain, as is or reversed, or reverse one in place,
+        keeping the first move that lowers the plan's cost (the DAG's path with its mop-up and the
+        way to the goal: a cheaper path may leave more to the mop-up), until none does or
+        :data:`ORDER_TRIES` orders have been tried. Returns the orders tried."""
+        n = len(self.sweeps)
+        if self.paper or not 2 <= n <= ORDER_SWEEPS:
+            return 0
+
+        def cost(order) -> float:  # the plan's: the DAG's path, then the mop-up and the way to the goal
+            for sweep, d in order:
+                if sweep.direction != d:
+                    sweep.direction = d
+                    self._regions(sweep)
+            g = self.dag([sweep for sweep, _ in order], start=self.start, goal=self.goal)
+            found, dag_path = self._solve(g)
+            if found is None:
+                return math.inf
+            return plan_total(self.lg, self.cov, self._vertex_path(g, dag_path), found, self.goal, self.mopup)
+
+        self._from = {}
+        current = [(sweep, sweep.direction) for sweep in self.sweeps]
+        best, tries = cost(current), 1
+        improved = True
+        while improved and tries < ORDER_TRIES:
+            improved = False
+            moves = [(i, i, True) for i in range(n)] + [
+                (i, j, flip) for i in range(1, n) for j in range(1, n) if i != j for flip in (False, True)]
+            for i, j, flip in moves:  # the first sweep holds the start: it may turn, never move
+                if tries >= ORDER_TRIES or (self.deadline is not None and time.perf_counter() > self.deadline):
+                    break
+                order = list(current)
+                sweep, d = order.pop(i)
+                order.insert(j, (sweep, -d if flip else d))
+                found = cost(order)
+                tries += 1
+                if found < best:
+                    best, current, improved = found, order, True
+                    break
+        cost(current)
+        self.sweeps = [sweep for sweep, _ in current]
+        self._from = None  # a large map's arrays: not kept past the search
+        return tries
+
+    def _vertex_path(self, g: nx.DiGraph, dag_path: list) -> list[int]:
+        """The workspace-graph vertices along a DAG path, from the start."""
+        path = [self.start]
+        for u, v in zip(dag_path[:-1], dag_path[1:]):
+            data = g.edges[u, v]
+            if data["kind"] == "fixed":
+                leg = data["path"] if "path" in data else _walk_back(*data["pred"])
+            else:
+                leg = self.results[(data["sweep"].key, data["layout"], data["block"], u[-1], v[-1])][1]
+            if leg and leg[0] == path[-1]:
+                leg = leg[1:]
+            path += leg
+        return path
 
     def plan(self) -> StripeOutcome:
         info: dict = {"sweeps": len(self.sweeps)}
         if not self.sweeps:
             info["dag"] = "no stripe has a piece: the whole map is covered by the mop-up walk"
             return self._outcome([self.start], None, 0, info)
+        info["order_tries"] = self._improve_order()
         g = self.dag(self.sweeps, start=self.start, goal=self.goal)
         info.update({"dag_nodes": g.number_of_nodes(), "dag_edges": g.number_of_edges()})
         dag_cost, dag_path = self._solve(g)
-        path, joins = [self.start], 0
         if dag_path is None:
             info["dag"] = "no path: the whole map is covered by the mop-up walk"
-            return self._outcome(path, None, 0, info)
+            return self._outcome([self.start], None, 0, info)
+        path, joins = self._vertex_path(g, dag_path), 0
         for u, v in zip(dag_path[:-1], dag_path[1:]):
             data = g.edges[u, v]
             if data["kind"] == "fixed":
-                leg = data["path"]
                 joins += int(data["cost"])
             else:
-                sweep = data["sweep"]
-                cost, leg = self.results[(sweep.key, sweep.direction, data["block"], u[2], v[2])]
-                sweep.cost += cost
-            if leg and leg[0] == path[-1]:
-                leg = leg[1:]
-            path += leg
+                sweep, layout = data["sweep"], data["layout"]
+                sweep.cost += self.results[(sweep.key, layout, data["block"], u[-1], v[-1])][0]
+                sweep.direction = layout[0]  # the chain the path takes: for the report and the plot
+                sweep.blocks, sweep.cuts = sweep.layouts[layout][:2]
+                sweep.folded = bool(layout[2])
         info["dag_path"] = [list(n) if isinstance(n, tuple) else n for n in dag_path]
+        info["dag_dropped"] = self._dropped(g, dag_path)  # the DAG's first criterion, before its cost
         info["dag_joins"] = joins  # commands of the DAG's fixed edges: start leg, cut-edges, transits, goal leg
         return self._outcome(path, int(dag_cost), 0, info)
 
@@ -591,7 +800,7 @@ class _Planner:
             details.append({
                 "rows": list(own), "band": list(band), "borrowed": (band[1] - band[0]) - (own[1] - own[0]),
                 "cost": sum(sw.cost for sw in mine), "pieces": len(mine), "regions": sum(len(sw.blocks) for sw in mine),
-                "direction": mine[0].direction if mine else 1,
+                "direction": mine[0].direction if mine else 1, "folded": any(sw.folded for sw in mine),
                 "cuts": sorted({b[0] if sw.direction > 0 else b[1] for sw in mine for b in sw.blocks[1:]})})
         info["order"] = [[sw.stripe, sw.direction] for sw in self.sweeps]
         info["widening"] = self.widening
@@ -599,31 +808,59 @@ class _Planner:
                              self.stats["memo_hits"], self.stats["nodes"], self.time_limited, info)
 
 
+def plan_total(lg: LayerGraph, cov: Coverability, path: list[int], dag_cost: float, goal: int | None,
+               mopup: str) -> float:
+    """Commands of a plan whose DAG path (costing ``dag_cost``) is ``path``: that, the mop-up, and the
+    way back to the goal if there is one."""
+    walk = [path[-1]] + mop_up(lg, path, cov.coverable, cov.reachable, order=mopup, goal=goal)
+    back = 0.0 if goal is None or walk[-1] == goal else shortest_path(lg, walk[-1], goal)[0]
+    return dag_cost + len(lg.commands_of(walk)) + back
+
+
+def _same_chain(a: tuple, b: tuple) -> bool:
+    """Two chains with the same regions, cuts and passes (a narrow sweep's cut grids may coincide)."""
+    return a[0] == b[0] and a[2] == b[2] and len(a[1]) == len(b[1]) and all(
+        np.array_equal(x, y) for x, y in zip(a[1], b[1]))
+
+
 def plan_stripes(lg: LayerGraph, cov: Coverability, start: int, goal: int | None, widths, *, region_columns: int,
-                 budget: int, deadline: float | None, memo: bool = True, paper: bool = False) -> StripeOutcome:
+                 budget: int, deadline: float | None, memo: bool = True, paper: bool = False,
+                 ends: str = "sweep", mopup: str = "sequenced") -> StripeOutcome:
     """The stripes' vertex path from ``start`` (to ``goal``, or a free end) along the auxiliary DAG's
     shortest path; the mop-up and the return to the goal are the caller's.
 
     Widening is cost-aware in the default variant: when a stripe split into pieces could also be
     joined by borrowing rows, the plan is made both ways (every split stripe swept piece by piece,
     and every such stripe widened as the paper does) and the one costing fewer commands with its
-    mop-up wins (ties: the split one)."""
-    options = dict(region_columns=region_columns, budget=budget, deadline=deadline, memo=memo, paper=paper)
-    planner = _Planner(lg, cov, start, goal, widths, **options, widening="joined" if paper else "split")
-    outcome = planner.plan()
-    if paper or not planner.choices:
-        return outcome
-    other = _Planner(lg, cov, start, goal, widths, **options, widening="joined").plan()
+    mop-up wins (ties: the split one). With ``ends="both"`` the ``"sweep"`` plans are candidates
+    too (ties: ``"both"``): the both-ends DAG is a superset, so its path never costs more, but its
+    mop-up may, and the plan must never cost more than ``"sweep"``'s. Every candidate shares one
+    memo of region searches (keyed by content)."""
+    options = dict(region_columns=region_columns, budget=budget, deadline=deadline, memo=memo, paper=paper,
+                   shared_memo={}, mopup=mopup)
+    first = "joined" if paper else "split"
+    planner = _Planner(lg, cov, start, goal, widths, **options, widening=first, ends=ends)
+    runs = {(first, ends): planner.plan()}
+    widenings = [first] + (["joined"] if not paper and planner.choices else [])
+    for widening, e in [(w, e) for e in dict.fromkeys((ends, "sweep")) for w in widenings]:
+        if (widening, e) not in runs:  # "both" keeps "sweep"'s plan as a candidate: never costlier with its mop-up
+            runs[(widening, e)] = _Planner(lg, cov, start, goal, widths, **options, widening=widening, ends=e).plan()
+    if len(runs) == 1:
+        return runs[(first, ends)]
 
-    def total(o: StripeOutcome) -> float:
-        if o.dag_cost is None:
-            return math.inf
-        return o.dag_cost + len(lg.commands_of([o.path[-1]] + mop_up(lg, o.path, cov.coverable, cov.reachable)))
-
-    costs = {"split": total(outcome), "joined": total(other)}
-    best = other if costs["joined"] < costs["split"] else outcome
-    best.info["widening_costs"] = costs
-    for name in ("regions", "regions_optimal", "memo_hits", "nodes"):  # both plans' searches count
-        setattr(best, name, getattr(outcome, name) + getattr(other, name))
-    best.time_limited = outcome.time_limited or other.time_limited
+    costs = {key: math.inf if o.dag_cost is None else plan_total(lg, cov, o.path, o.dag_cost, goal, mopup)
+             for key, o in runs.items()}
+    key = min(costs, key=lambda k: (costs[k], k[1] != ends, k[0] != first))  # ties: the asked ends, split
+    best = runs[key]
+    if len(widenings) > 1:
+        best.info["widening_costs"] = {w: min(c for (w2, _), c in costs.items() if w2 == w) for w in widenings}
+    if ends != "sweep":
+        best.info["ends_costs"] = {e: min(c for (_, e2), c in costs.items() if e2 == e) for e in (ends, "sweep")}
+        best.info["ends_dag_costs"] = {  # the DAG's criteria: targets left to the mop-up, then commands
+            e: min(([o.info["dag_dropped"], o.dag_cost] for (_, e2), o in runs.items()
+                    if e2 == e and o.dag_cost is not None), default=None) for e in (ends, "sweep")}
+    best.info["ends"] = key[1]
+    for name in ("regions", "regions_optimal", "memo_hits", "nodes"):  # every plan's searches count
+        setattr(best, name, sum(getattr(o, name) for o in runs.values()))
+    best.time_limited = any(o.time_limited for o in runs.values())
     return best
