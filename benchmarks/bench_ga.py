@@ -26,8 +26,18 @@
    (:func:`~htetro_opt.algorithms.reaching_hypervolume`).
 5. Diversity (not run by default): ``HTetroGA(reach_share=...)``, the goal-reaching section capped
    at a share of the population, on the same four maps, with and without re-planning.
+6. Moving obstacles (not run by default): the default hTetro-GA's re-planning step with its
+   time-expanded search, with the static-only search (``timed=False``) and without re-planning, on
+   parallel_dynamic's leg, n_pop 50, a fixed number of generations (300; quick 100), seeds 0-2, side
+   by side in one process: CPU per run and the fastest goal-reaching member's gap to the exact optimum.
+7. Routes (not run by default): the route classes among the goal-reaching members of the default
+   hTetro-GA's population, generation by generation (400 generations, n_pop 50, seeds 0-4; quick 2),
+   with and without ``reach_share=0.75``: on three_slit the slit B2 passes (the rows where it is in
+   the wall's columns x = 11, 12), on h_shape the side of the middle block it goes round (B2 left of
+   x = 6 or right of x = 17). Reported: the route of the fastest member at the first reaching
+   generation and at the end, the routes left at the end, and the generations holding two or more.
 
-Run:  python benchmarks/bench_ga.py [--quick] [--parts timing,split,termination,diversity,quality] [--repeat N]
+Run:  python benchmarks/bench_ga.py [--quick] [--parts timing,split,termination,diversity,moving,routes,quality] [--repeat N]
                                     [--jobs N] [--methods htetro-ga,htetro-ga-paper]
 
 --quick: 1 seed per timing cell, 2 termination and diversity seeds, and quality with 2 seeds and max_gen 300 (full:
@@ -52,8 +62,10 @@ from pymoo.optimize import minimize
 from htetro_opt.algorithms import HTetroGA, make_algorithm
 from htetro_opt.algorithms import htetro_ga as htetro_ga_module
 from htetro_opt.model import SEED000_COMMANDS, Simulator
+from htetro_opt.operators.commands import sequences
 from htetro_opt.problems import CommandPathProblem
 from htetro_opt.scenarios import load_scenario
+from htetro_opt.solvers.grid_paths import plan_exact
 from htetro_opt.studies.metrics import format_mean_std
 from htetro_opt.studies.table4 import ENVIRONMENTS, run_table4, summarise
 
@@ -300,7 +312,6 @@ def print_termination(records: list[dict], seeds: int) -> None:
           "| HV loss mean | HV loss max |")
     print("|---|---:|---:|---:|---:|---:|---:|")
     by = {(r["map"], r["seed"], r["measure"]): r for r in records}
-    totals = defaultdict(float)
     for name in TERMINATION_MAPS + ("all",):
         names = TERMINATION_MAPS if name == "all" else (name,)
         pairs = [(by[(m, s, "best")], by[(m, s, "hypervolume")]) for m in names for s in range(seeds)]
@@ -320,7 +331,6 @@ def diversity(seeds: int, windows=(40, 0), shares=(1.0, 0.75)) -> list[dict]:
     from pymoo.optimize import minimize as run
 
     from htetro_opt.algorithms import FrontConvergence, select_solutions
-    from htetro_opt.solvers.grid_paths import plan_exact
 
     records = []
     for name in TERMINATION_MAPS:
@@ -357,6 +367,101 @@ def print_diversity(records: list[dict], seeds: int) -> None:
         print(f"| {name} | {window} | {share:g} | {np.nanmean(fastest):.1f} / {np.nanmax(fastest):.1f} "
               f"| {int((fastest > 3).sum())} of {len(cell)} | {np.nanmean(balanced):.1f} / {np.nanmax(balanced):.1f} "
               f"| {np.mean([r['generations'] for r in cell]):.0f} | {np.mean([r['cpu_s'] for r in cell]):.1f} |")
+    print()
+
+
+MOVING_VARIANTS = ("time-expanded", "static-only", "off")
+
+
+def moving(generations: int, seeds: int = 3) -> list[dict]:
+    """Part 6: the re-planning step's searches on parallel_dynamic, side by side, seed by seed."""
+    scenario = load_scenario("parallel_dynamic")
+    sim = Simulator(scenario.workspace, commands=SEED000_COMMANDS)
+    exact = plan_exact(sim, scenario.roadmap[:2]).time
+    records = []
+    for seed in range(seeds):
+        for variant in MOVING_VARIANTS:
+            problem = CommandPathProblem(sim, scenario.start, scenario.roadmap[1], max_length=100)
+            algorithm = HTetroGA(50, replan_window=0 if variant == "off" else 40)
+            if variant == "static-only":
+                algorithm.replan.timed = False
+            began = time.process_time()
+            res = minimize(problem, algorithm, ("n_gen", generations), seed=seed)
+            cpu = time.process_time() - began
+            times, reached = res.pop.get("time"), res.pop.get("reached").astype(bool)
+            records.append({"seed": seed, "variant": variant, "exact": exact, "cpu_s": cpu,
+                            "fastest": float(times[reached].min()) if reached.any() else float("nan")})
+            print(f"  parallel_dynamic seed {seed} {variant}: fastest {records[-1]['fastest']:g} (exact {exact:g}), "
+                  f"{cpu:.1f} s", file=sys.stderr, flush=True)
+    return records
+
+
+def print_moving(records: list[dict], generations: int) -> None:
+    print(f"## Re-planning on parallel_dynamic: n_pop 50, {generations} generations, CPU per run\n")
+    print("| re-planning | fastest gap % per seed | CPU s mean | CPU ratio to no re-planning |")
+    print("|---|---|---:|---:|")
+    cpu = {v: np.mean([r["cpu_s"] for r in records if r["variant"] == v]) for v in MOVING_VARIANTS}
+    for v in MOVING_VARIANTS:
+        gaps = [100 * (r["fastest"] - r["exact"]) / r["exact"] for r in records if r["variant"] == v]
+        print(f"| {v} | {', '.join(f'{g:.1f}' for g in gaps)} | {cpu[v]:.1f} | {cpu[v] / cpu['off']:.2f} |")
+    print()
+
+
+def route_class(name: str, poses: np.ndarray) -> str:
+    """Part 7's route of a path (its poses, (x, y, state, heading) rows)."""
+    x, y = poses[:, 0], poses[:, 1]
+    if name == "three_slit":
+        return "slit y=" + "+".join(str(v) for v in sorted(set(y[(x == 11) | (x == 12)].tolist())))
+    return "+".join(side for side, hit in (("left", (x < 6).any()), ("right", (x > 17).any())) if hit) or "none"
+
+
+class _Routes(Callback):
+    """Each generation's routes of the goal-reaching members, with each route's fastest time."""
+
+    def __init__(self, problem, name):
+        super().__init__()
+        self.problem, self.name, self.log = problem, name, []
+
+    def notify(self, algorithm):
+        result = self.problem.simulate(sequences(algorithm.pop.get("X")))
+        routes = {}
+        for i in np.flatnonzero(result.reached):
+            route = route_class(self.name, result.poses(i))
+            routes[route] = min(routes.get(route, np.inf), float(result.time[i]))
+        self.log.append(routes)
+
+
+def routes(seeds: int, generations: int = 400) -> list[dict]:
+    """Part 7, seed by seed."""
+    records = []
+    for name in ("three_slit", "h_shape"):
+        scenario = load_scenario(name)
+        sim = Simulator(scenario.workspace, commands=SEED000_COMMANDS)
+        for share in (1.0, 0.75):
+            for seed in range(seeds):
+                problem = CommandPathProblem(sim, scenario.start, scenario.roadmap[1], max_length=100)
+                log = _Routes(problem, name)
+                minimize(problem, HTetroGA(50, reach_share=share), ("n_gen", generations), seed=seed, callback=log)
+                reaching = [r for r in log.log if r]
+                first, last = reaching[0], log.log[-1]
+                records.append({"map": name, "share": share, "seed": seed,
+                                "first": min(first, key=first.get), "first_time": min(first.values()),
+                                "last": min(last, key=last.get), "last_time": min(last.values()),
+                                "routes": dict(sorted(last.items(), key=lambda kv: kv[1])),
+                                "multi": sum(len(r) >= 2 for r in reaching), "reaching": len(reaching)})
+                print(f"  {name} share {share} seed {seed}: {records[-1]}", file=sys.stderr, flush=True)
+    return records
+
+
+def print_routes(records: list[dict]) -> None:
+    print("## Route classes of the goal-reaching members: n_pop 50, 400 generations\n")
+    print("| map | reach share | seed | fastest at first reach | fastest at the end | routes at the end (fastest time) "
+          "| generations with >= 2 routes / with a reaching member |")
+    print("|---|---:|---:|---|---|---|---|")
+    for r in records:
+        left = ", ".join(f"{k} ({v:g})" for k, v in r["routes"].items())
+        print(f"| {r['map']} | {r['share']:g} | {r['seed']} | {r['first']} ({r['first_time']:g}) "
+              f"| {r['last']} ({r['last_time']:g}) | {left} | {r['multi']} / {r['reaching']} |")
     print()
 
 
@@ -399,14 +504,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer seeds and a smaller quality budget")
     parser.add_argument("--parts", default="timing,split,termination,quality",
-                        help="comma-separated: timing, split, termination, diversity, quality")
+                        help="comma-separated: timing, split, termination, diversity, moving, routes, quality")
     parser.add_argument("--repeat", type=int, help="seeds per timing cell (default 3, quick 1)")
     parser.add_argument("--jobs", type=int, default=1, help="processes for the quality runs (default 1)")
     parser.add_argument("--methods", default="htetro-ga,htetro-ga-paper",
                         help="comma-separated methods for the quality runs (default htetro-ga,htetro-ga-paper)")
     args = parser.parse_args()
     parts = {p.strip() for p in args.parts.split(",") if p.strip()}
-    unknown = parts - {"timing", "split", "termination", "diversity", "quality"}
+    unknown = parts - {"timing", "split", "termination", "diversity", "moving", "routes", "quality"}
     if unknown:
         parser.error(f"unknown parts: {', '.join(sorted(unknown))}")
     repeat = args.repeat or (1 if args.quick else 3)
@@ -422,6 +527,11 @@ def main() -> None:
     if "diversity" in parts:
         seeds = 2 if args.quick else 5
         print_diversity(diversity(seeds), seeds)
+    if "moving" in parts:
+        generations = 100 if args.quick else 300
+        print_moving(moving(generations), generations)
+    if "routes" in parts:
+        print_routes(routes(2 if args.quick else 5))
     if "quality" in parts:
         seeds, max_gen = (2, 300) if args.quick else (10, 1000)
         methods = [m.strip() for m in args.methods.split(",") if m.strip()]

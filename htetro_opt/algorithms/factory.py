@@ -13,22 +13,65 @@ from typing import Mapping, Sequence
 from pymoo.core.infill import InfillCriterion
 from pymoo.core.population import Population
 
-from htetro_opt._validation import check_int, check_probability, check_real
-from htetro_opt.algorithms.htetro_ga import HTetroGA
+from htetro_opt._validation import check_bool, check_int, check_probability, check_real
+from htetro_opt.algorithms.htetro_ga import HTetroGA, trim_reached
 from htetro_opt.errors import ParameterError
 from htetro_opt.operators.commands import (
     CommandCrossover,
     CommandDuplicateElimination,
     CommandMutation,
+    CommandRearrangement,
+    CommandRemoval,
     CommandRepair,
     CommandReplan,
     CommandSampling,
+    CommandShortcut,
     replan_rows,
 )
 
-__all__ = ["GA_ALGORITHMS", "ReplanMating", "make_algorithm"]
+__all__ = ["GA_ALGORITHMS", "ConservativeMating", "ReplanMating", "make_algorithm"]
 
 _PYMOO_REPLAN = (0, 3)  # pymoo's algorithms: the re-planning off unless asked for (W), K when it is on
+
+
+class ConservativeMating(InfillCriterion):
+    """A pymoo algorithm's own mating, plus the hTetro-GA's conservative offspring set.
+
+    Each generation the wrapped mating makes its offspring as usual; then every member of the
+    population gets one conservative child, as in the hTetro-GA (Cheng et al. 2020, Fig. 7):
+    removal, then rearrangement (:class:`~htetro_opt.operators.CommandRemoval`,
+    :class:`~htetro_opt.operators.CommandRearrangement`), then, as the hTetro-GA's default does, the
+    shortcut (:class:`~htetro_opt.operators.CommandShortcut`) and the mating's repair. A
+    goal-reaching member is first cut to its executed prefix (its genes after the goal never run),
+    so that removal keeps the cell where it stops (:func:`~htetro_opt.algorithms.trim_reached`).
+    The children, less the duplicates, join the offspring, which then number up to n_offsprings +
+    pop_size, as the hTetro-GA's two sets do; every pymoo survival used here cuts pop + off back to
+    pop_size. Given to pymoo's algorithms through their ``mating`` so that swapping the algorithm
+    compares algorithms, not operator sets.
+
+    Parameters
+    ----------
+    mating : pymoo Mating
+        The algorithm's own (``algorithm.mating`` as pymoo built it).
+    """
+
+    def __init__(self, mating) -> None:
+        super().__init__(repair=mating.repair, eliminate_duplicates=mating.eliminate_duplicates,
+                         n_max_iterations=mating.n_max_iterations)
+        self.mating = mating
+        self.operators = (CommandRemoval(), CommandRearrangement(), CommandShortcut())
+
+    def do(self, problem, pop, n_offsprings, random_state=None, **kwargs):
+        off = self.mating.do(problem, pop, n_offsprings, random_state=random_state, **kwargs)
+        if len(pop) == 0 or pop.get("F") is None:
+            return off
+        parents = Population.new(X=pop.get("X"), reached=pop.get("reached"), executed=pop.get("executed"))
+        children = trim_reached(parents)
+        for operator in self.operators:
+            children = operator.do(problem, children, random_state=random_state)
+        children = self.repair.do(problem, children, random_state=random_state)
+        children = self.eliminate_duplicates.do(children, pop, off)
+        return Population.merge(off, children) if len(children) else off
 
 
 class ReplanMating(InfillCriterion):
@@ -86,6 +129,7 @@ def make_algorithm(
     replan_window: int | None = None,
     replan_members: int | None = None,
     reach_share: float | None = None,
+    conservative: bool | None = None,
     include: Sequence = (),
 ):
     """A pymoo algorithm over command chromosomes.
@@ -109,6 +153,10 @@ def make_algorithm(
     reach_share : float, optional
         The hTetro-GA's cap on the goal-reaching section of its sort (:class:`HTetroGA`); None: the
         default, 1 (no cap). pymoo's algorithms have no such sort: a share other than 1 is refused there.
+    conservative : bool, optional
+        pymoo's algorithms only: add the hTetro-GA's conservative offspring set (removal,
+        rearrangement, shortcut) to their mating (:class:`ConservativeMating`); None: off (their
+        defaults stay pymoo's). The hTetro-GA always makes that set: a value is refused there.
     include : sequence of int arrays
         Chromosomes put into the initial population (:class:`CommandSampling`'s ``include``).
 
@@ -117,7 +165,8 @@ def make_algorithm(
     ParameterError
         If the name is unknown, ``pop_size`` is below 2, ``crossover_rate`` is not a probability, a
         sampling weight is negative, ``replan_window`` or ``replan_members`` is negative,
-        ``reach_share`` is not in (0, 1] or below 1 for one of pymoo's, or ``"agemoea"`` is asked for
+        ``reach_share`` is not in (0, 1] or below 1 for one of pymoo's, ``conservative`` is not a bool
+        or is given for the hTetro-GA, or ``"agemoea"`` is asked for
         without numba installed (pymoo's AGE-MOEA needs it: the ``agemoea`` extra).
 
     Examples
@@ -134,6 +183,11 @@ def make_algorithm(
               (("replan_window", replan_window), ("replan_members", replan_members)) if value is not None}
     if reach_share is not None:
         replan["reach_share"] = check_real(reach_share, "reach_share", minimum=0.0, maximum=1.0, include_minimum=False)
+    if conservative is not None:
+        conservative = check_bool(conservative, "conservative")
+        if name in ("htetro-ga", "htetro-ga-paper"):
+            raise ParameterError(f"conservative applies to pymoo's algorithms (nsga2, nsga3, smsemoa, agemoea), not to "
+                                 f"{name!r}, which always makes the conservative offspring set")
     if name == "htetro-ga":
         return HTetroGA(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate, **replan)
     if name == "htetro-ga-paper":
@@ -148,6 +202,8 @@ def make_algorithm(
         repair=CommandRepair(),
     )
     algorithm = _pymoo_algorithm(name, pop_size, operators)
+    if conservative:
+        algorithm.mating = ConservativeMating(algorithm.mating)
     window = replan.get("replan_window", _PYMOO_REPLAN[0])
     if window:
         algorithm.mating = ReplanMating(algorithm.mating, window, replan.get("replan_members", _PYMOO_REPLAN[1]))

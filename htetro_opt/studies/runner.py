@@ -33,7 +33,8 @@ on the first four maps of its Table 6). The options:
   ``"hypervolume"``), ``pick`` (``"balanced"``, ``"fastest"``, ``"smoothest"``, ``"safest"``),
   ``seed_exact``, ``replan_window``, ``replan_members`` (the GAs; pymoo's algorithms re-plan only
   when given a window), ``reach_share`` (the hTetro-GA's sort: ``htetro-ga`` and
-  ``htetro-ga-paper`` only; see :func:`~htetro_opt.solvers.grid_paths.plan_ga`); ``weights``
+  ``htetro-ga-paper`` only), ``conservative`` (pymoo's algorithms only; see
+  :func:`~htetro_opt.solvers.grid_paths.plan_ga`); ``weights``
   (``[w_t, w_sm, w_sf]`` or ``"w_t,w_sm,w_sf"``), ``t_max``, ``element`` (``"q1"`` or ``"p0"``),
   ``monotone``, ``band`` (``"auto"``, ``"full"`` or a radius in cells) (the heat planner of
   Do et al. 2021, which always plans with the diagonals);
@@ -438,6 +439,7 @@ def _check_weights(value, name: str) -> list[float]:
 
 _ALL = None  # an option every method of the task takes
 _HTETRO_GA = ("htetro-ga", "htetro-ga-paper")  # the hTetro-GA's own sort: pymoo's algorithms have none
+_PYMOO_GA = ("nsga2", "nsga3", "smsemoa", "agemoea")  # the conservative set is the hTetro-GA's own
 _OPTIONS: dict[str, dict[str, tuple[Callable, str | None]]] = {
     # option: (check, which methods take it: None all, "exact" the graph searches, "heat" Do et al.
     # 2021's planner, "ga" the others, or a tuple of kinds and method names)
@@ -454,6 +456,7 @@ _OPTIONS: dict[str, dict[str, tuple[Callable, str | None]]] = {
         "replan_window": (lambda v, n: check_int(v, n, minimum=0), "ga"),
         "replan_members": (lambda v, n: check_int(v, n, minimum=0), "ga"),
         "reach_share": (lambda v, n: check_real(v, n, minimum=0.0, maximum=1.0, include_minimum=False), _HTETRO_GA),
+        "conservative": (check_bool, _PYMOO_GA),
         "weights": (_check_heat_weights, "heat"),
         "t_max": (lambda v, n: check_real(v, n, minimum=0.0, include_minimum=False), "heat"),
         "element": (_check_element, "heat"),
@@ -487,6 +490,7 @@ _REFERENCE_OPTIONS = {"plan": ("clearance", "diagonals"), "sequence": ("start", 
 
 _SCOPE_NAMES = {"exact": "the exact methods (dijkstra, astar)", "heat": "the heat planner (Do et al. 2021)",
                 "ga": "the GA methods", _HTETRO_GA: "the hTetro-GA methods (htetro-ga, htetro-ga-paper)",
+                _PYMOO_GA: "pymoo's algorithms (nsga2, nsga3, smsemoa, agemoea)",
                 "stripes": "the stripes methods (stripes, stripes-paper)",
                 ("stripes", "tiling-tsp"): "the stripes methods (stripes, stripes-paper) and tiling-tsp"}
 
@@ -1209,7 +1213,7 @@ def run_trial(task: str, scenario: str, method: str, parameters: Mapping[str, An
     parameters : mapping
         The verb's options, as a study's method entry gives them (``plan``: clearance, diagonals,
         pop_size, max_gen, patience, max_length, convergence, pick, seed_exact, replan_window,
-        replan_members, reach_share, and the heat planner's weights, t_max, element,
+        replan_members, reach_share, conservative, and the heat planner's weights, t_max, element,
         monotone, band; ``tile``: shapes, overlap, shuffle, time_limit; ``sequence``: start,
         weights, time_limit, shapes; ``cover``: shapes, start, clearance, stripes, region_columns,
         budget, time_limit).

@@ -138,3 +138,66 @@ def test_nsga2_with_the_replanning_reaches_and_stays_valid(small_problem):
     X = sequences(res.pop.get("X"))
     assert len(res.pop) == 12 and np.array_equal(small_problem.evaluate(as_column(X)), res.pop.get("F"))
     assert (res.pop.get("F")[:, 0] == -1).any()
+
+
+# --- the conservative offspring set for pymoo's algorithms ----------------------------------------
+@pytest.mark.parametrize("name", PYMOO)
+def test_pymoo_algorithms_take_the_conservative_set_through_their_mating(name):
+    from pymoo.core.mating import Mating
+
+    from htetro_opt.algorithms import ConservativeMating, ReplanMating
+
+    if name == "agemoea":
+        pytest.importorskip("numba")
+    assert type(make_algorithm(name, 12).mating) is Mating
+    conservative = make_algorithm(name, 12, conservative=True)
+    assert isinstance(conservative.mating, ConservativeMating) and conservative.mating.mating.selection is not None
+    both = make_algorithm(name, 12, conservative=True, replan_window=9)
+    assert isinstance(both.mating, ReplanMating) and isinstance(both.mating.mating, ConservativeMating)
+    assert type(make_algorithm(name, 12, conservative=False).mating) is Mating
+
+
+@pytest.mark.parametrize("name", ["htetro-ga", "htetro-ga-paper"])
+@pytest.mark.parametrize("value", [True, False])
+def test_the_htetro_ga_refuses_the_conservative_option(name, value):
+    with pytest.raises(ParameterError, match="conservative"):
+        make_algorithm(name, 12, conservative=value)
+
+
+@pytest.mark.parametrize("value", [1, "yes", 2.5])
+def test_conservative_must_be_a_bool(value):
+    with pytest.raises(ParameterError, match="conservative"):
+        make_algorithm("nsga2", 12, conservative=value)
+
+
+def test_the_conservative_set_adds_one_new_child_per_member_to_pymoos_own_offspring():
+    # control: the same population and seeds without the conservative set
+    from pymoo.core.population import Population
+
+    from htetro_opt.model import format_commands, parse_commands
+
+    ws = Workspace(np.zeros((8, 8), dtype=bool))
+    problem = CommandPathProblem(ws, Pose(1, 2, "O", 0), Pose(5, 2, "O", 0), max_length=10)
+    loopy = parse_commands("x+,x+,r+,r-,x+,x+")  # reaches the goal in 8 s; its loop r+ r- costs 4
+    wander = parse_commands("y+,y+,x+")
+    X = as_column([loopy, wander])
+    outcomes = problem.outcomes(problem.simulate(sequences(X)))
+    members = {tuple(format_commands(x)) for x in (loopy, wander)}
+    straight = ("x+",) * 4
+    hits = {True: 0, False: 0}
+    for seed in range(6):
+        offspring = {}
+        for conservative in (True, False):
+            pop = Population.new(X=X, F=outcomes["F"], reached=outcomes["reached"], executed=outcomes["executed"],
+                                 rank=np.array([0, 1]), crowding=np.array([np.inf, np.inf]))
+            algorithm = make_algorithm("nsga2", 2, conservative=conservative)
+            algorithm.setup(problem, seed=seed)  # pymoo's selection draws from the algorithm's stream
+            off = algorithm.mating.do(problem, pop, 2, random_state=algorithm.random_state, algorithm=algorithm)
+            offspring[conservative] = [tuple(format_commands(x)) for x in sequences(off.get("X"))]
+            assert all(np.isin(x, problem.command_ids).all() for x in sequences(off.get("X")))
+            hits[conservative] += straight in offspring[conservative]
+        own, extra = offspring[True][: len(offspring[False])], offspring[True][len(offspring[False]):]
+        assert own == offspring[False]  # pymoo's own offspring are untouched: the set draws after them
+        assert 1 <= len(extra) <= 2  # at most one child per member, and here never all duplicates
+        assert not (set(extra) & (members | set(own))) and len(set(extra)) == len(extra)
+    assert hits[True] and not hits[False]  # the set can cut the loop; pymoo's own operators did not

@@ -14,6 +14,7 @@ from htetro_opt.model import SEED000_COMMANDS, MovingObstacle, Pose, Simulator, 
 from htetro_opt.model.robot import STATE_NAMES
 from htetro_opt.operators.commands import CommandReplan, TransitionGraph, replan_windows, sequences
 from htetro_opt.problems import CommandPathProblem
+from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers.grid_paths import plan_exact
 
 SEED_IDS = parse_commands(",".join(SEED000_COMMANDS))
@@ -147,6 +148,92 @@ def test_with_moving_obstacles_the_result_revalidates_and_timed_is_the_exact_opt
         result = problem.simulate([out])
         assert result.valid[0] and result.reached[0] and result.time[0] <= slow_result.time[0]
     assert problem.simulate([timed]).time[0] == oracle.time
+
+
+def as_pose(row) -> Pose:
+    return Pose(int(row[0]), int(row[1]), STATE_NAMES[int(row[2])], int(row[3]))
+
+
+@pytest.mark.parametrize("name", ["parallel_dynamic", "perpendicular_dynamic"])
+def test_the_timed_search_is_the_exact_planners_optimum_valid_at_its_times(name):
+    # oracle: plan_exact's time-expanded Dijkstra from the window's start time; windows between poses
+    # of the exact plan of a bundled moving-obstacle map (Cheng et al. 2020), started at their own times
+    scenario = load_scenario(name)
+    sim = Simulator(scenario.workspace)
+    graph = TransitionGraph(sim)
+    plan = plan_exact(sim, scenario.roadmap)
+    trace = sim.run([plan.commands], scenario.roadmap[0]).poses(0)
+    period = scenario.workspace.period
+    rng = np.random.default_rng(3)
+    waited = 0
+    for _ in range(12):
+        i = int(rng.integers(0, len(trace) - 2))
+        j = int(rng.integers(i + 1, min(len(trace), i + 41)))
+        a, b = as_pose(trace[i]), as_pose(trace[j])
+        oracle = plan_exact(sim, [a, b], t0=i)
+        [(commands, time)] = graph.fastest(sim.encode(a), i, sim.encode(b), j, limit=200.0)
+        check = sim.run([commands], a, roadmap=[b], t0=i)  # valid at the times it runs
+        assert check.valid[0] and check.reached[0] and time == check.time[0] == oracle.time
+        # arriving at another phase than the fastest may need waits: still valid, never faster
+        shift = int(rng.integers(1, 6))
+        same = graph.fastest(sim.encode(a), i, sim.encode(b), j + shift, limit=200.0, same_phase=True)
+        if same:
+            [(later, later_time)] = same
+            check = sim.run([later], a, roadmap=[b], t0=i)
+            assert check.valid[0] and check.reached[0] and check.time[0] == later_time >= time
+            assert (i + len(later)) % period == (j + shift) % period
+            waited += 1
+    assert waited
+
+
+def pocket_map() -> Workspace:
+    """The corridor of ``moving_map`` with its moving block walled off in a pocket it never leaves."""
+    occ = bordered(14, 12)
+    occ[8, :] = True  # the pocket: rows 9-10, out of the robot's reach
+    route = tuple((k, 0) for k in range(5)) + tuple((k, 0) for k in range(3, 0, -1))
+    return Workspace(occ, moving=(MovingObstacle(cells=((3, 9),), route=route, speed=1),))
+
+
+def test_the_timed_search_equals_the_static_search_where_the_obstacles_never_come():
+    ws = pocket_map()
+    sim, static = Simulator(ws), Simulator(Workspace(ws.occupancy))
+    timed_graph, static_graph = TransitionGraph(sim), TransitionGraph(static)
+    assert timed_graph.period > 1  # the time-expanded search runs
+    rng = np.random.default_rng(0)
+    found = 0
+    for _ in range(20):
+        a = Pose(int(rng.integers(2, 11)), int(rng.integers(2, 6)), str(rng.choice(list("OSZT"))), int(rng.integers(4)))
+        b = Pose(int(rng.integers(2, 11)), int(rng.integers(2, 6)), str(rng.choice(list("OSZT"))), int(rng.integers(4)))
+        if sim.pose_conflicts(sim.encode(a), 0) or sim.pose_conflicts(sim.encode(b), 0) or a == b:
+            continue
+        t = int(rng.integers(0, 40))
+        timed = timed_graph.fastest(sim.encode(a), t, sim.encode(b), t, limit=60.0)
+        plain = static_graph.fastest(static.encode(a), 0, static.encode(b), 0, limit=60.0)
+        assert [time for _, time in timed] == [time for _, time in plain]
+        found += len(timed)
+    assert found
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_on_a_moving_map_windows_stay_valid_at_their_times_and_never_get_longer(seed):
+    ws = moving_map()
+    problem = CommandPathProblem(ws, Pose(5, 2, "O", 0), Pose(11, 2, "O", 0), max_length=40)
+    rng = np.random.default_rng(seed)
+    seqs = walk(problem, rng, n=10, length=40)
+    before = problem.simulate(seqs)
+    out = replan_windows(problem, seqs, window=12, random_state=np.random.default_rng(seed))
+    # The executed part is what is re-planned; the genes after it are kept, and on a moving map they
+    # may run differently at the new times, so the executed part is checked alone.
+    executed = [out[k][: len(out[k]) - (len(seqs[k]) - int(before.executed[k]))] for k in range(len(seqs))]
+    after = problem.simulator.run(executed, problem.start_id, t0=problem.t0)
+    shorter = 0
+    for k in range(len(seqs)):
+        assert np.array_equal(out[k][len(executed[k]):], seqs[k][int(before.executed[k]):])
+        assert after.valid[k]  # valid at the times it runs
+        assert np.array_equal(after.poses(k)[-1], before.poses(k)[-1])
+        assert after.time[k] <= before.time[k] + 1e-9
+        shorter += after.time[k] < before.time[k] - 1e-9
+    assert shorter  # random walks hold detours: not vacuous
 
 
 def test_random_state_reproducibility_and_global_rng_untouched():

@@ -46,6 +46,26 @@ def test_pymoo_algorithm_records_the_replanning_run():
     assert record["commands"] == ",".join(plan.tokens) and record["replan_window"] == 20
 
 
+@pytest.mark.parametrize("method", ["htetro-ga", "htetro-ga-paper"])
+def test_the_conservative_option_is_pymoos_algorithms_only(method):
+    assert _study(method="nsga3", conservative=True).methods[0].options == {"conservative": True}
+    with pytest.raises(StudyError, match=r"methods\[0\]: conservative applies to pymoo's algorithms "
+                                         rf"\(nsga2, nsga3, smsemoa, agemoea\) only, not to {method}"):
+        _study(method=method, conservative=True)
+    with pytest.raises(StudyError, match=r"methods\[0\]: conservative"):
+        _study(method="nsga2", conservative="yes")
+
+
+def test_pymoo_algorithm_records_the_conservative_run():
+    options = {"pop_size": 12, "max_gen": 8, "conservative": True, "replan_window": 20}
+    record = run_trial("plan", "random", "smsemoa", options, 0)
+    grid = load_scenario("random")
+    plan = plan_path(grid.workspace, grid.roadmap, method="smsemoa", seed=0, **options)
+    plain = plan_path(grid.workspace, grid.roadmap, method="smsemoa", seed=0, **{**options, "conservative": False})
+    assert record["commands"] == ",".join(plan.tokens) and record["conservative"] is True
+    assert str(plan.legs[0].front) != str(plain.legs[0].front)  # the option reaches the algorithm
+
+
 @pytest.mark.parametrize("method", ["dijkstra", "exact", "astar", "heat"])
 @pytest.mark.parametrize("key, value", sorted(OPTIONS.items()))
 def test_exact_and_heat_methods_refuse_every_ga_option_by_name(method, key, value):

@@ -4,8 +4,8 @@ A memetic step that generalises the shortcut (:mod:`.shortcut` cuts a window who
 equal; here they may differ): a window of up to W executed commands is replaced by the minimum-time
 command sequence between the poses before and after it, found by scipy's Dijkstra on the simulator's
 transition table, the search bounded by the window's own time so that it stays local. With moving
-obstacles the graph is time-expanded over their period (the obstacles' clock is the number of
-commands executed, as in the simulator), so the new window is valid at the times it runs.
+obstacles the search is time-expanded (the obstacles' clock is the number of commands executed, as
+in the simulator), so the new window is valid at the times it runs.
 """
 
 from __future__ import annotations
@@ -29,16 +29,22 @@ _ANSWERS = 1 << 14  # searches :meth:`TransitionGraph.fastest` remembers (a few 
 
 
 class TransitionGraph:
-    """The simulator's transition table as CSR graphs for scipy's Dijkstra, each built once.
+    """The simulator's transition table as a CSR graph for scipy's Dijkstra, built once.
 
     The static graph has one node per pose and an edge between two poses when a valid command leads
     from one to the other, weighted by the cheapest such command's duration (a command that leaves
-    the pose unchanged only costs time, and is left out). With moving obstacles there is also the
-    time-expanded graph: a node per pose and phase of their period (node = phase × n_poses + pose;
-    the obstacles' clock is the number of commands executed, as in the simulator), the edges of the
-    commands valid when they start, and a command that leaves the pose unchanged is a wait. These
-    are the graphs the exact planner (:func:`~htetro_opt.solvers.grid_paths.plan_exact`) searches,
-    so a window re-planned on them is the exact optimum between its ends.
+    the pose unchanged only costs time, and is left out). With moving obstacles the search is
+    time-expanded: a state is a pose and a phase of their period (the obstacles' clock is the number
+    of commands executed, as in the simulator), the commands valid when they start are its edges, and
+    a command that leaves the pose unchanged is a wait. These are the graphs the exact planner
+    (:func:`~htetro_opt.solvers.grid_paths.plan_exact`) searches, so a window re-planned on them is the
+    exact optimum between its ends. The time-expanded graph is never built whole (on a 24 × 24 map
+    with a period of 40 it has 645 120 nodes, and scipy's Dijkstra allocates its arrays over all of
+    them at every search): the search runs layer by layer, bounded by the window's own time and by
+    the static time to the window's end (see :meth:`_timed`), and visits only the window's
+    neighbourhood. Measured on the Cheng et al. 2020 moving-obstacle maps (40 windows of up to 40
+    commands of the exact plan, bound 200 s): 1.3–1.5 ms a search (median), 11 ms at most;
+    benchmarks/README.md has the cost inside hTetro-GA runs.
 
     :meth:`fastest` remembers its answers (the last 16384 questions): the graphs never change and
     the search is deterministic, so a question asked again gets the same answer without a search.
@@ -72,87 +78,166 @@ class TransitionGraph:
         sim = self.simulator = simulator
         self.n_poses = sim.n_poses
         self.period = sim.workspace.period if sim.workspace.moving else 1
-        self._graphs: dict[bool, tuple[csr_matrix, np.ndarray]] = {}
+        self._static: tuple[csr_matrix, np.ndarray] | None = None
+        self._reverse: csr_matrix | None = None
+        self._labels: np.ndarray | None = None  # the timed search's best time per (phase, pose), reset after use
         self._answers: dict[tuple, list] = {}
-        self._graph(timed=False)
+        self._graph()
 
-    def _graph(self, *, timed: bool) -> tuple[csr_matrix, np.ndarray]:
-        """The static (``timed`` False) or time-expanded graph, and the local command of each edge."""
-        timed = timed and self.period > 1
-        if timed in self._graphs:
-            return self._graphs[timed]
+    def _graph(self) -> tuple[csr_matrix, np.ndarray]:
+        """The static graph, and the local command of each edge."""
+        if self._static is not None:
+            return self._static
         sim, n, c = self.simulator, self.n_poses, self.simulator.n_commands
-        period = self.period if timed else 1
         target = sim.next[:n, :c].astype(np.int64)
         durations = sim.durations[:c]
         usable = target != sim.dead
-        if not timed:
-            usable &= target != np.arange(n)[:, None]
         if (durations[np.flatnonzero(usable.any(axis=0))] <= 0).any():
             raise PlanningError("exact re-planning needs every command that moves the robot to take a positive time")
+        usable &= target != np.arange(n)[:, None]  # a command that leaves the pose unchanged only costs time
         pose, column = np.nonzero(usable)
         # Each pose's entries by (next pose, duration): the first of each (pose, next pose) group is the
         # cheapest edge, and CSR wants each row's columns sorted (scipy would sum duplicates).
         order = np.lexsort((durations[column], target[pose, column], pose))
         pose, column = pose[order], column[order]
-        indptr, indices, weights, commands = [np.zeros(1, dtype=np.int64)], [], [], []
-        for phase in range(period):
-            p, col = pose, column
-            if timed:  # before the grouping: a blocked cheap command must not hide a free costly one
-                keys = pose * sim.n_columns + column
-                blocked = sim.blocked_keys(phase)
-                if len(blocked):
-                    free = blocked[np.searchsorted(blocked, keys).clip(max=len(blocked) - 1)] != keys
-                    p, col = pose[free], column[free]
-            nxt = target[p, col]
-            first = np.r_[True, (p[1:] != p[:-1]) | (nxt[1:] != nxt[:-1])]
-            p, col, nxt = p[first], col[first], nxt[first]
-            indptr.append(indptr[-1][-1] + np.cumsum(np.bincount(p, minlength=n)))
-            indices.append(nxt + ((phase + 1) % period) * n)
-            weights.append(durations[col])
-            commands.append(col)
-        size = n * period
-        index_type = np.int32 if max(size, int(indptr[-1][-1])) < 2**31 else np.int64
-        matrix = csr_matrix((np.concatenate(weights), np.concatenate(indices).astype(index_type),
-                             np.concatenate(indptr).astype(index_type)), shape=(size, size))
-        self._graphs[timed] = matrix, np.concatenate(commands).astype(np.int16)
-        return self._graphs[timed]
+        nxt = target[pose, column]
+        first = np.r_[True, (pose[1:] != pose[:-1]) | (nxt[1:] != nxt[:-1])]
+        pose, column, nxt = pose[first], column[first], nxt[first]
+        indptr = np.r_[0, np.cumsum(np.bincount(pose, minlength=n))]
+        index_type = np.int32 if max(n, len(nxt)) < 2**31 else np.int64
+        matrix = csr_matrix((durations[column], nxt.astype(index_type), indptr.astype(index_type)), shape=(n, n))
+        self._static = matrix, column.astype(np.int16)
+        return self._static
 
     def fastest(self, source: int, t: int, target: int, t_end: int, *, limit: float,
-                static: bool = False) -> list[tuple[np.ndarray, float]]:
-        """The fastest command sequences from pose ``source`` at time ``t`` to pose ``target`` that take
-        at most ``limit``: one per distinct arrival, the fastest first.
+                static: bool = False, same_phase: bool = False) -> list[tuple[np.ndarray, float]]:
+        """The fastest command sequence from pose ``source`` at time ``t`` to pose ``target`` that takes
+        at most ``limit``, as a list of one (empty when there is none).
 
         On a static map, or with ``static`` (moving obstacles ignored: a lower bound, whose path is
-        valid only where they are not), that is the one minimum-time sequence. With moving obstacles
-        it is the fastest over every arrival phase, then, if it arrives at another phase than
-        ``t_end``'s, the fastest arriving at ``t_end``'s phase (what follows the window then runs at
-        the same obstacle times as before). Empty when nothing reaches ``target`` within ``limit``.
+        valid only where they are not), that is the minimum-time sequence. With moving obstacles it
+        is the fastest at any arrival time or, with ``same_phase``, the fastest arriving at ``t_end``'s
+        phase of the obstacles' period (what follows the window then runs at the same obstacle times
+        as before).
 
         Returns
         -------
         list of (ndarray of int, float)
             Global command ids and their total duration.
         """
-        matrix, commands = self._graph(timed=not static)
-        n, period = self.n_poses, matrix.shape[0] // self.n_poses
-        start = (t % period) * n + source
-        query = (period, start, int(target), t_end % period, float(limit))
+        timed = not static and self.period > 1
+        period = self.period if timed else 1
+        arrival = t_end % period if timed and same_phase else None
+        query = (period, (t % period) * self.n_poses + source, int(target), arrival, float(limit))
         if query in self._answers:
             return self._answers[query]
-        dist, pred = dijkstra(matrix, indices=start, return_predecessors=True,
-                              limit=limit * (1 + _TOLERANCE) + _TOLERANCE)
-        ends = target + n * np.arange(period)
-        best = int(ends[np.argmin(dist[ends])])
-        same = int(ends[t_end % period])
-        answer = [(self._path(matrix, commands, start, end, pred), float(dist[end]))
-                  for end in dict.fromkeys((best, same)) if np.isfinite(dist[end])]
+        bound = limit * (1 + _TOLERANCE) + _TOLERANCE
+        answer = self._timed(source, t, target, arrival, bound) if timed else self._static_search(source, target, bound)
         for path, _ in answer:
             path.flags.writeable = False  # shared by every caller asking the same
         if len(self._answers) >= _ANSWERS:
             del self._answers[next(iter(self._answers))]  # the oldest
         self._answers[query] = answer
         return answer
+
+    def _static_search(self, source: int, target: int, bound: float) -> list[tuple[np.ndarray, float]]:
+        matrix, commands = self._graph()
+        dist, pred = dijkstra(matrix, indices=source, return_predecessors=True, limit=bound)
+        if not np.isfinite(dist[target]):
+            return []
+        return [(self._path(matrix, commands, source, int(target), pred), float(dist[target]))]
+
+    def _timed(self, source: int, t: int, target: int, arrival: int | None,
+               limit: float) -> list[tuple[np.ndarray, float]]:
+        """The time-expanded search: layered searches (:meth:`_layers`) under a rising bound.
+
+        Every label of a layered search satisfies time + static time to ``target`` ≤ the bound, so
+        a search whose bound is at least the optimum finds it. The first bound is the static
+        optimum (the moving obstacles only remove edges, so nothing is faster); each next one is
+        the smallest pruned label's (time + static time to go) or, if larger, the static optimum
+        plus twice the last excess, so that a window whose optimum waits long costs a few searches,
+        not one per distinct time. The neighbourhood searched is then that of the optimum, not that
+        of the window's own time, which may be far larger.
+        """
+        if self._reverse is None:
+            self._reverse = self._graph()[0].T.tocsr()
+            self._labels = np.full(self.period * self.n_poses, np.inf)
+        to_go = dijkstra(self._reverse, indices=target, limit=limit)
+        floor = float(to_go[source])
+        if not floor <= limit:
+            return []
+        bound = min(limit, floor * (1 + _TOLERANCE) + _TOLERANCE)
+        while True:
+            found, pruned = self._layers(source, t, target, arrival, bound, to_go)
+            if found or bound >= limit or not np.isfinite(pruned):
+                return found
+            bound = min(limit, max(pruned, floor + 2 * (bound - floor)) * (1 + _TOLERANCE) + _TOLERANCE)
+
+    def _layers(self, source: int, t: int, target: int, arrival: int | None, bound: float,
+                to_go: np.ndarray) -> tuple[list[tuple[np.ndarray, float]], float]:
+        """One layered search under ``bound``: the fastest arrival (at phase ``arrival`` if given) and
+        the smallest time + time to go of the labels the bound pruned.
+
+        A label is (pose, time) after k commands; a layer expands every label by every command
+        valid at its phase (a command that leaves the pose unchanged is a wait) and keeps, per pose,
+        the fastest. A label is pruned when its time plus the static minimum time to ``target`` (a
+        lower bound) exceeds ``bound`` (lowered to the best arrival once one is found), or when it
+        is no faster than an earlier label of the same pose at the same phase of the period.
+        """
+        sim, n, period = self.simulator, self.n_poses, self.period
+        if source == target and (arrival is None or t % period == arrival):
+            return [(sim.command_ids[:0], 0.0)], np.inf  # already there: the window was a wait
+        c = sim.n_commands
+        columns = np.arange(c)
+        durations = sim.durations[:c]
+        labels, touched = self._labels, []
+        poses, times = np.array([source], dtype=np.int64), np.zeros(1)
+        layers = []  # per layer: (row of the label it came from, local command)
+        best, pruned = None, np.inf  # best: (time, layer, row)
+        try:
+            while len(poses):
+                k = len(layers)
+                after = sim.next[poses, :c].astype(np.int64)
+                valid = after != sim.dead
+                blocked = sim.blocked_keys(t + k)
+                if len(blocked):
+                    keys = poses[:, None] * sim.n_columns + columns
+                    valid &= blocked[np.searchsorted(blocked, keys).clip(max=len(blocked) - 1)] != keys
+                arrive = times[:, None] + durations
+                estimate = arrive + to_go[np.where(valid, after, source)]
+                over = valid & (estimate > bound)
+                if over.any():
+                    pruned = min(pruned, float(estimate[over].min()))
+                row, column = np.nonzero(valid & ~over)
+                if not len(row):
+                    break
+                nxt, when = after[row, column], arrive[row, column]
+                order = np.lexsort((when, nxt))  # per next pose, the fastest first
+                first = order[np.r_[True, nxt[order][1:] != nxt[order][:-1]]]
+                row, column, nxt, when = row[first], column[first], nxt[first], when[first]
+                phase = (t + k + 1) % period
+                node = phase * n + nxt
+                better = when < labels[node] - _TOLERANCE
+                row, column, nxt, when, node = row[better], column[better], nxt[better], when[better], node[better]
+                labels[node] = when
+                touched.append(node)
+                layers.append((row, column))
+                hit = np.flatnonzero(nxt == target)
+                if len(hit) and (arrival is None or phase == arrival) and (best is None or when[hit[0]] < best[0]):
+                    best = (float(when[hit[0]]), len(layers), int(hit[0]))
+                    bound = min(bound, best[0] + _TOLERANCE)  # nothing slower is wanted any more
+                poses, times = nxt, when  # those beyond a lowered bound have no children
+        finally:
+            for node in touched:
+                labels[node] = np.inf
+        if best is None:
+            return [], pruned
+        time, layer, r = best
+        path = []
+        for row, column in reversed(layers[:layer]):
+            path.append(column[r])
+            r = row[r]
+        return [(sim.command_ids[np.array(path[::-1], dtype=np.int64)], time)], pruned
 
     def _path(self, matrix: csr_matrix, commands: np.ndarray, start: int, end: int, pred: np.ndarray) -> np.ndarray:
         nodes = [end]
@@ -167,7 +252,7 @@ class TransitionGraph:
 
 
 def replan_windows(problem, seqs: list[np.ndarray], *, window: int, random_state: np.random.Generator,
-                   graph: TransitionGraph | None = None, timed: bool = False) -> list[np.ndarray]:
+                   graph: TransitionGraph | None = None, timed: bool = True) -> list[np.ndarray]:
     """Replace one window of each chromosome's executed commands by the fastest way between its ends.
 
     Each chromosome is simulated from the problem's start (with its goal and child termination);
@@ -180,12 +265,9 @@ def replan_windows(problem, seqs: list[np.ndarray], *, window: int, random_state
 
     With moving obstacles the static graph is searched first: its optimum is a lower bound (a
     window that cannot beat it is left alone) and, when it runs clear of the obstacles at the times it
-    runs and leaves the rest of the path valid, it is the window's optimum. With ``timed``, a window
-    whose static optimum collides is then re-planned on the time-expanded graph (see
-    :meth:`TransitionGraph.fastest`), which gives its exact optimum but costs, on a 24 × 24 map with
-    a period of 40, about 25 ms a window against under 1 ms: measured on parallel_dynamic, nearly every
-    window of a converged population needs it (its optimum waits for the obstacles), and a default
-    hTetro-GA run took 29 times the CPU of one without re-planning. Off by default, so on
+    runs and leaves the rest of the path valid, it is the window's optimum. With ``timed`` (the
+    default), a window whose static optimum collides is then re-planned by the time-expanded search
+    (see :meth:`TransitionGraph.fastest`), which gives its exact optimum; without it, on
     moving-obstacle maps the step improves a window only where the obstacles leave the static optimum
     free.
 
@@ -201,7 +283,7 @@ def replan_windows(problem, seqs: list[np.ndarray], *, window: int, random_state
         Draws the windows.
     graph : TransitionGraph, optional, keyword-only
         The problem's simulator's graph, if already built (building it costs more than a search).
-    timed : bool, keyword-only
+    timed : bool, default True, keyword-only
         With moving obstacles, fall back on the time-expanded search (see above).
 
     Raises
@@ -237,13 +319,13 @@ def replan_windows(problem, seqs: list[np.ndarray], *, window: int, random_state
         i = int(random_state.integers(0, done - length + 1))
         windows.append((int(k), i, i + length, float(durations[k, i : i + length].sum())))
 
-    def improve(windows, static: bool) -> list:
-        """Re-plan ``windows`` on one graph; those whose candidates all failed."""
-        candidates = []  # (window, new executed part), each window's in order of preference
+    def improve(windows, **question) -> list:
+        """Re-plan ``windows`` by one question to the graph; those whose candidates all failed."""
+        candidates = []  # (window, new executed part)
         for w in windows:
             k, i, j, spent = w
             for path, time in graph.fastest(int(trace[k, i]), problem.t0 + i, int(trace[k, j]), problem.t0 + j,
-                                            limit=spent, static=static):
+                                            limit=spent, **question):
                 if time < spent - _TOLERANCE:
                     done = seqs[k][: executed[k]]
                     candidates.append((w, np.concatenate([done[:i], path, done[j:]]).astype(np.int64)))
@@ -260,8 +342,12 @@ def replan_windows(problem, seqs: list[np.ndarray], *, window: int, random_state
         return list(dict.fromkeys(w for w, _ in candidates if w[0] not in settled))
 
     unsettled = improve(windows, static=True)
-    if timed and graph.period > 1 and unsettled:
-        improve(unsettled, static=False)
+    if timed and graph.period > 1:
+        # The fastest at any phase first; where it leaves the rest of the path invalid (the obstacles
+        # meet it at other times), the fastest arriving at the old phase, which keeps the rest's times.
+        for same_phase in (False, True):
+            if unsettled:
+                unsettled = improve(unsettled, static=False, same_phase=same_phase)
     return out
 
 
@@ -307,7 +393,7 @@ class CommandReplan(Mutation):
     ----------
     window : int
         W, the most executed commands a window holds.
-    timed : bool, keyword-only
+    timed : bool, default True, keyword-only
         With moving obstacles, fall back on the time-expanded search (see :func:`replan_windows`).
     prob : float, keyword-only
         pymoo's per-individual probability that the operator is applied.
@@ -318,7 +404,7 @@ class CommandReplan(Mutation):
         If ``window`` is not a positive integer, ``timed`` not a bool or ``prob`` not a probability.
     """
 
-    def __init__(self, window: int = 40, *, timed: bool = False, prob: float = 1.0) -> None:
+    def __init__(self, window: int = 40, *, timed: bool = True, prob: float = 1.0) -> None:
         super().__init__(prob=check_probability(prob, "replan prob"))
         self.window = check_int(window, "replan window", minimum=1)
         self.timed = check_bool(timed, "timed")

@@ -145,6 +145,7 @@ def plan_ga(
     seed_exact: bool = False,
     pick: str = "balanced",
     reach_share: float | None = None,
+    conservative: bool | None = None,
 ) -> Plan:
     """Plan through a roadmap with a command-chromosome GA, one optimisation per leg.
 
@@ -217,6 +218,10 @@ def plan_ga(
         (ours; :class:`~htetro_opt.algorithms.HTetroGA`). None: 1, no cap, the paper's sort (measured
         in benchmarks/README.md: 0.75 changes little once the re-planning is on). pymoo's algorithms
         refuse a share below 1.
+    conservative : bool, optional, keyword-only
+        pymoo's algorithms only: add the hTetro-GA's conservative offspring set (removal,
+        rearrangement, shortcut) to their mating (:class:`~htetro_opt.algorithms.ConservativeMating`);
+        None: off. Refused for the hTetro-GA, which always makes it.
 
     Returns
     -------
@@ -244,7 +249,7 @@ def plan_ga(
     (True, 7.0)
     """
     make_algorithm(algorithm, pop_size, replan_window=replan_window, replan_members=replan_members,
-                   reach_share=reach_share)  # validates
+                   reach_share=reach_share, conservative=conservative)  # validates
     seed_exact = check_bool(seed_exact, "seed_exact")
     if not isinstance(pick, str) or pick not in PICKS:
         raise ParameterError(f"pick must be one of {', '.join(PICKS)}, got {pick!r}")
@@ -282,7 +287,8 @@ def plan_ga(
         termination = FrontConvergence(max_gen=max_gen, patience=patience, measure=convergence)
         res = minimize(problem, make_algorithm(algorithm, pop_size, sampling_weights=sampling_weights,
                                                replan_window=replan_window, replan_members=replan_members,
-                                               reach_share=reach_share, include=include),
+                                               reach_share=reach_share, conservative=conservative,
+                                               include=include),
                        termination, seed=int(leg_seeds[leg]), callback=recorder, verbose=verbose)
         X, F = res.pop.get("X"), res.pop.get("F")
         chosen = select_solutions(F)
