@@ -131,6 +131,7 @@ def make_algorithm(
     reach_share: float | None = None,
     conservative: bool | None = None,
     include: Sequence = (),
+    reach_patience: int | None = None,
 ):
     """A pymoo algorithm over command chromosomes.
 
@@ -159,13 +160,20 @@ def make_algorithm(
         defaults stay pymoo's). The hTetro-GA always makes that set: a value is refused there.
     include : sequence of int arrays
         Chromosomes put into the initial population (:class:`CommandSampling`'s ``include``).
+    reach_patience : int, optional
+        The hTetro-GA's reach repair (:class:`HTetroGA`): after this many generations without a
+        reaching member and without a rise of the best f_gr, the member nearest to the goal gets the
+        minimum-time path to it. None: the default (100 for ``"htetro-ga"``, off for
+        ``"htetro-ga-paper"``); 0 turns it off. pymoo's algorithms have no such step: a value other
+        than 0 is refused there.
 
     Raises
     ------
     ParameterError
         If the name is unknown, ``pop_size`` is below 2, ``crossover_rate`` is not a probability, a
         sampling weight is negative, ``replan_window`` or ``replan_members`` is negative,
-        ``reach_share`` is not in (0, 1] or below 1 for one of pymoo's, ``conservative`` is not a bool
+        ``reach_share`` is not in (0, 1] or below 1 for one of pymoo's, ``reach_patience`` is negative
+        or positive for one of pymoo's, ``conservative`` is not a bool
         or is given for the hTetro-GA, or ``"agemoea"`` is asked for
         without numba installed (pymoo's AGE-MOEA needs it: the ``agemoea`` extra).
 
@@ -183,6 +191,8 @@ def make_algorithm(
               (("replan_window", replan_window), ("replan_members", replan_members)) if value is not None}
     if reach_share is not None:
         replan["reach_share"] = check_real(reach_share, "reach_share", minimum=0.0, maximum=1.0, include_minimum=False)
+    if reach_patience is not None:
+        replan["reach_patience"] = check_int(reach_patience, "reach_patience", minimum=0)
     if conservative is not None:
         conservative = check_bool(conservative, "conservative")
         if name in ("htetro-ga", "htetro-ga-paper"):
@@ -192,6 +202,8 @@ def make_algorithm(
         return HTetroGA(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate, **replan)
     if name == "htetro-ga-paper":
         return HTetroGA.as_published(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate, **replan)
+    if replan.pop("reach_patience", 0):
+        raise ParameterError(f"reach_patience applies to the hTetro-GA (htetro-ga, htetro-ga-paper), not to {name!r}")
     if replan.get("reach_share", 1.0) < 1.0:
         raise ParameterError(f"reach_share applies to the hTetro-GA (htetro-ga, htetro-ga-paper), not to {name!r}")
     operators = dict(

@@ -11,7 +11,7 @@ never executed), so that the conservative operators keep its end cell: without t
 ``x+`` before the goal with an ``x−`` after it would move where the child stops. ``trim_reached=False``
 keeps the genes whole.
 
-Four additions of ours are on by default, each switchable, and :meth:`HTetroGA.as_published` turns
+Five additions of ours are on by default, each switchable, and :meth:`HTetroGA.as_published` turns
 them all off:
 
 - **repair** (:class:`~htetro_opt.operators.CommandRepair`): every new chromosome has its invalid
@@ -24,7 +24,15 @@ them all off:
   the fastest goal-reaching member and of a few random reaching members is replaced by the minimum-time
   path between the window's end poses; the re-planned chromosomes join the offspring. It generalises
   the shortcut and is the only operator that makes the 2–4-gene changes a route needs (``sS … sO``
-  where ``y+ … y−`` would do), so the fastest member no longer stays above the exact optimum.
+  where ``y+ … y−`` would do), so the fastest member no longer stays above the exact optimum;
+- **reach repair** (:class:`~htetro_opt.operators.commands.CommandReachRepair`, ``reach_patience``):
+  re-planning touches only goal-reaching members, so a run whose population gets stuck without
+  reaching stays stuck (measured: parallel_dynamic, seed 9, the whole population on the goal cell in
+  the wrong morphology for 1000 generations). When no member reaches and the population's best
+  goal reachability f_gr has not risen for ``reach_patience`` generations, the member nearest to the
+  goal has its tail after the pose nearest to the goal replaced by the minimum-time path from there
+  to the goal (time-expanded on moving maps), and joins the offspring. A run that reaches before
+  stalling that long is untouched (the step draws no random numbers before it fires).
 
 **The loop runs on arrays.** A generation keeps the population as a list of chromosomes beside
 ``F`` and the auxiliary columns (``reached``, ``executed``, ``time``, ``end``, ``rank``, ``crowding``):
@@ -66,7 +74,7 @@ from htetro_opt.operators.commands import (
 from htetro_opt.operators.commands import as_column, sequences
 from htetro_opt.operators.commands.batch import apply_crossover, apply_mutation
 from htetro_opt.operators.commands.duplicates import chromosome_key, first_keys
-from htetro_opt.operators.commands.replan import CommandReplan, replan_rows
+from htetro_opt.operators.commands.replan import CommandReachRepair, CommandReplan, replan_rows
 from htetro_opt.operators.commands.shortcut import repair_shortcut_evaluate
 
 __all__ = ["HTetroGA", "trim_reached"]
@@ -180,12 +188,18 @@ class HTetroGA(GeneticAlgorithm):
         rest (ours, off by default: 1 = the paper's sort, see
         :class:`~htetro_opt.operators.GoalReachabilitySurvival`; measured in benchmarks/README.md,
         0.75 changes little once the re-planning is on).
+    reach_patience : int
+        Generations without a reaching member and without a rise of the population's best f_gr after
+        which the member nearest to the goal is reach-repaired (ours; 0 = off; see the module
+        docstring and :class:`~htetro_opt.operators.commands.CommandReachRepair`). The default, 100,
+        is the termination's patience: a search that has stalled as long as a run is allowed to
+        stall once it reaches.
 
     Raises
     ------
     ParameterError
         If ``pop_size`` is below 2, ``crossover_rate`` is not a probability, ``niche_size``,
-        ``replan_window`` or ``replan_members`` is negative or a switch is not a bool.
+        ``replan_window``, ``replan_members`` or ``reach_patience`` is negative or a switch is not a bool.
 
     Notes
     -----
@@ -223,6 +237,7 @@ class HTetroGA(GeneticAlgorithm):
         replan_window: int = 40,
         replan_members: int = 3,
         reach_share: float = 1.0,
+        reach_patience: int = 100,
         **kwargs,
     ) -> None:
         pop_size = check_int(pop_size, "pop_size", minimum=2)
@@ -248,14 +263,18 @@ class HTetroGA(GeneticAlgorithm):
         self.replan_window = check_int(replan_window, "replan_window", minimum=0)
         self.replan_members = check_int(replan_members, "replan_members", minimum=0)
         self.replan = CommandReplan(self.replan_window) if self.replan_window else None
+        self.reach_patience = check_int(reach_patience, "reach_patience", minimum=0)
+        self.reach_repair = CommandReachRepair() if self.reach_patience else None
+        self._closest, self._stalled = -np.inf, 0  # the best f_gr so far, generations since it last rose
 
     @classmethod
     def as_published(cls, pop_size: int = 50, **kwargs) -> "HTetroGA":
-        """The hTetro-GA with none of our additions: no repair, no shortcut, no niching, no re-planning.
+        """The hTetro-GA with none of our additions: no repair, no shortcut, no niching, no re-planning,
+        no reach repair.
 
         A keyword given here switches one back on (e.g. ``replan_window=40``).
         """
-        options = dict(repair=False, shortcut=False, niche_size=0, replan_window=0)
+        options = dict(repair=False, shortcut=False, niche_size=0, replan_window=0, reach_patience=0)
         options.update(kwargs)
         return cls(pop_size, **options)
 
@@ -317,6 +336,9 @@ class HTetroGA(GeneticAlgorithm):
             members = self._replan_members(rng)
             if len(members):
                 off = off + apply_mutation(self.replan, problem, [X[i] for i in members], random_state=rng)
+        stuck = self._stuck()
+        if stuck is not None:
+            off = off + apply_mutation(self.reach_repair, problem, [X[stuck]], random_state=rng)
         keys = [chromosome_key(x) for x in off]
         keep = first_keys(keys, set(parents.keys()))
         if not len(keep):
@@ -329,6 +351,22 @@ class HTetroGA(GeneticAlgorithm):
             outcomes = problem.outcomes(problem.simulate(X_replanned))
             new = new + _Members(X_replanned, outcomes["F"], outcomes, keys=[keys[i] for i in replanned])
         return new
+
+    def _stuck(self) -> int | None:
+        """The row to reach-repair this generation, if the search has stalled without reaching: the
+        member nearest to the goal (largest f_gr, then fastest, the first of equals)."""
+        members = self._members
+        if self.reach_repair is None or members.reached.any():
+            return None
+        closest = float(-members.F[:, 0].min())  # F = −fitness
+        if closest > self._closest + 1e-12:
+            self._closest, self._stalled = closest, 0
+            return None
+        self._stalled += 1
+        if self._stalled < self.reach_patience:
+            return None
+        self._stalled = 0  # if the repair fails, the next try waits another reach_patience generations
+        return int(np.lexsort((members.time, members.F[:, 0]))[0])
 
     def _replan_members(self, rng: np.random.Generator) -> np.ndarray:
         """Rows to re-plan: the fastest goal-reaching member (the first of equals) and

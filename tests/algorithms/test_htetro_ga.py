@@ -229,3 +229,70 @@ def test_a_reaching_share_keeps_explorers(problem):
         res = minimize(problem, HTetroGA(pop_size=20, reach_share=share), ("n_gen", 15), seed=0)
         counts[share] = int(res.pop.get("reached").astype(bool).sum())
     assert counts[1.0] == 20 and counts[0.5] == 10
+
+
+# --- the reach repair (ours) -------------------------------------------------------------------------
+def stalled_run(problem, seqs, n_gen, **options):
+    """A frozen hTetro-GA (see ``frozen``) from the chromosomes ``seqs``: nothing but the reach repair
+    can change its population, so a population that does not reach stays stalled."""
+    recorder = ConvergenceRecorder()
+    algorithm = frozen(sampling=Population.new("X", as_column(seqs)), **options)
+    res = minimize(problem, algorithm, ("n_gen", n_gen), seed=0, callback=recorder)
+    return res, recorder
+
+
+def test_a_stalled_run_on_a_moving_map_is_reach_repaired_after_its_patience():
+    # oracle: plan_exact's time-expanded optimum; the repaired member re-validates in the Simulator
+    from htetro_opt.model import Simulator
+    from htetro_opt.scenarios import load_scenario
+
+    scenario = load_scenario("parallel_dynamic")
+    sim = Simulator(scenario.workspace)
+    start, goal = scenario.roadmap
+    problem = CommandPathProblem(sim, start, goal, max_length=100)
+    rng = np.random.default_rng(0)
+    walks = sim.run([rng.choice(problem.command_ids, 30) for _ in range(10)], problem.start_id, repair=rng)
+    seqs = [walks.sequence(i) for i in range(10)]
+    assert not problem.simulate(seqs).reached.any()
+    optimum = plan_exact(sim, [start, goal]).time
+
+    res, recorder = stalled_run(problem, seqs, 9, reach_patience=5)
+    assert recorder.reach_generation is not None and recorder.reach_generation > 5  # waited its patience
+    reached = res.pop.get("reached").astype(bool)
+    assert reached.any()
+    for x, t in zip(sequences(res.pop.get("X")[reached]), res.pop.get("time")[reached]):
+        check = sim.run([x], problem.start_id, roadmap=[goal], t0=problem.t0)  # all of it, at its times
+        assert check.valid[0] and check.reached[0] and check.time[0] == t >= optimum
+    again, _ = stalled_run(problem, seqs, 9, reach_patience=5)
+    assert population_arrays(again)[1] == population_arrays(res)[1]  # same seed, same result
+    for options in (dict(reach_patience=0), dict(reach_patience=20)):
+        off, recorder = stalled_run(problem, seqs, 9, **options)
+        assert recorder.reach_generation is None and not off.pop.get("reached").astype(bool).any()
+
+
+def test_the_reach_repair_is_on_by_default_off_as_published_and_idle_in_a_run_that_reaches(problem):
+    assert HTetroGA(10).reach_patience == 100 and HTetroGA(10).reach_repair is not None
+    assert HTetroGA.as_published(10).reach_patience == 0 and HTetroGA.as_published(10).reach_repair is None
+    assert make_algorithm("htetro-ga-paper", 10).reach_repair is None
+    assert make_algorithm("htetro-ga-paper", 10, reach_patience=7).reach_patience == 7  # switched back on
+    # this run reaches in its first generations: at the default patience the repair never fires and
+    # draws nothing, so the run is the one without it; at a patience of 1 it fires before the reach
+    runs = {}
+    for patience in (100, 0, 1):
+        recorder = ConvergenceRecorder()
+        res = minimize(problem, HTetroGA(16, reach_patience=patience), ("n_gen", 12), seed=4, callback=recorder)
+        runs[patience] = population_arrays(res)[1]
+        assert recorder.reach_generation is not None and recorder.reach_generation < 12
+    assert runs[100] == runs[0] != runs[1]
+
+
+@pytest.mark.parametrize("value", [-1, 2.5, None, True])
+def test_reach_patience_parameters(value):
+    with pytest.raises(ParameterError, match="reach_patience"):
+        HTetroGA(10, reach_patience=value)
+    if value is not None:
+        with pytest.raises(ParameterError, match="reach_patience"):
+            make_algorithm("htetro-ga", 10, reach_patience=value)
+    with pytest.raises(ParameterError, match="reach_patience applies to the hTetro-GA"):
+        make_algorithm("nsga2", 10, reach_patience=5)
+    assert type(make_algorithm("nsga2", 10, reach_patience=0)).__name__ == "NSGA2"

@@ -1,5 +1,6 @@
 """Windowed exact re-planning: keeps the start and the end pose, never slower, re-validates, and a
-window holding a detour becomes the exact optimum between its ends (oracle: plan_exact)."""
+window holding a detour becomes the exact optimum between its ends (oracle: plan_exact). The reach
+repair: the repaired path reaches at its times, its tail is the exact optimum from the pose kept."""
 
 from __future__ import annotations
 
@@ -10,9 +11,26 @@ import pytest
 from pymoo.core.population import Population
 
 from htetro_opt.errors import ParameterError
-from htetro_opt.model import SEED000_COMMANDS, MovingObstacle, Pose, Simulator, Timing, Workspace, parse_commands
+from htetro_opt.model import (
+    SEED000_COMMANDS,
+    MovingObstacle,
+    Pose,
+    Simulator,
+    Timing,
+    Workspace,
+    format_commands,
+    parse_commands,
+)
 from htetro_opt.model.robot import STATE_NAMES
-from htetro_opt.operators.commands import CommandReplan, TransitionGraph, replan_windows, sequences
+from htetro_opt.operators.commands import (
+    CommandReachRepair,
+    CommandReplan,
+    TransitionGraph,
+    as_column,
+    reach_repair,
+    replan_windows,
+    sequences,
+)
 from htetro_opt.problems import CommandPathProblem
 from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers.grid_paths import plan_exact
@@ -272,3 +290,86 @@ def test_bad_windows(window):
     problem = CommandPathProblem(Workspace(bordered()), Pose(2, 2, "O", 0), Pose(6, 2, "O", 0), max_length=10)
     with pytest.raises(ParameterError, match="replan window"):
         replan_windows(problem, [parse_commands("x+")], window=window, random_state=np.random.default_rng(0))
+
+
+# --- the reach repair (ours) ------------------------------------------------------------------------
+def check_reach_repair(problem, seqs, out):
+    """Each output reaches the goal (re-simulated from the start at its times), keeps a prefix of its
+    input's executed commands and, after it, is the exact planner's optimum from that pose at that
+    time; none beats the exact optimum from the start. Returns how many were repaired."""
+    sim = problem.simulator
+    before, after = problem.simulate(seqs), problem.simulate(out)
+    optimum = plan_exact(sim, [problem.start, problem.goal], t0=problem.t0).time
+    repaired = 0
+    for k, (old, new) in enumerate(zip(seqs, out)):
+        if before.reached[k]:
+            assert new is old
+            continue
+        if new is old:
+            continue
+        repaired += 1
+        run = sim.run([new], problem.start_id, roadmap=[problem.goal], t0=problem.t0)  # no stop: all of it runs
+        assert run.valid[0] and run.reached[0] and after.executed[k] == len(new)
+        assert problem.t_max + 1e-9 >= after.time[k] >= optimum - 1e-9
+        trace = before.poses(k)
+        common = next((i for i in range(min(len(old), len(new))) if old[i] != new[i]), min(len(old), len(new)))
+        common = min(common, int(before.executed[k]))
+        tail = float(problem.durations[new].sum())
+
+        def exact_from(i):
+            return plan_exact(sim, [as_pose(trace[i]), problem.goal], t0=problem.t0 + i).time
+
+        assert any(abs(tail - float(problem.durations[new[:i]].sum()) - exact_from(i)) < 1e-9
+                   for i in range(common, -1, -1))
+    return repaired
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_reach_repair_on_a_moving_map_reaches_at_its_times_and_never_beats_the_optimum(seed):
+    # oracle: plan_exact's time-expanded search from the pose kept, at its time, and from the start
+    scenario = load_scenario("parallel_dynamic")
+    sim = Simulator(scenario.workspace)
+    start, goal = scenario.roadmap[0], scenario.roadmap[1]
+    problem = CommandPathProblem(sim, start, goal, max_length=100)
+    seqs = walk(problem, np.random.default_rng(seed), n=6, length=30)
+    assert not problem.simulate(seqs).reached.any()
+    out = reach_repair(problem, seqs)
+    assert check_reach_repair(problem, seqs, out) == len(seqs)
+    assert [s.tolist() for s in reach_repair(problem, seqs)] == [s.tolist() for s in out]  # deterministic
+
+
+def test_reach_repair_on_a_static_map_and_members_that_reach_are_left_alone():
+    ws = cluttered(1)
+    problem = CommandPathProblem(ws, Pose(2, 2, "O", 0), Pose(11, 11, "O", 0), max_length=40)
+    optimum = plan_exact(ws, [problem.start, problem.goal])
+    seqs = walk(problem, np.random.default_rng(5), n=8, length=25) + [optimum.commands]
+    out = reach_repair(problem, seqs)
+    assert check_reach_repair(problem, seqs, out) == 8
+    assert out[-1] is seqs[-1]
+
+
+def test_reach_repair_keeps_what_it_cannot_repair_within_t_max():
+    # t_max = 4 s: the goal 9 cells away cannot be reached within it, whatever the pose kept
+    problem = CommandPathProblem(Workspace(bordered(14, 6)), Pose(2, 2, "O", 0), Pose(11, 2, "O", 0), max_length=4)
+    seqs = [parse_commands("x+,x+,x+"), parse_commands("y+")]
+    out = reach_repair(problem, seqs)
+    assert all(new is old for new, old in zip(out, seqs))
+    # with a budget that allows it, the path is repaired from its last pose
+    roomy = CommandPathProblem(problem.simulator, problem.start, problem.goal, max_length=12)
+    [first, _] = reach_repair(roomy, seqs)
+    assert format_commands(first) == ["x+"] * 9
+
+
+def test_reach_repair_operator_draws_nothing_but_pymoos_prob_and_builds_its_graph_once():
+    problem = CommandPathProblem(cluttered(2), Pose(2, 2, "O", 0), Pose(11, 11, "O", 0), max_length=40)
+    seqs = walk(problem, np.random.default_rng(1), n=4, length=20)
+    op = CommandReachRepair()
+    state = random.getstate()
+    pop = op.do(problem, Population.new("X", as_column(seqs)), random_state=np.random.default_rng(0))
+    assert random.getstate() == state
+    assert [s.tolist() for s in sequences(pop.get("X"))] == [s.tolist() for s in reach_repair(problem, seqs)]
+    graph = op.graph(problem.simulator)
+    op.do(problem, Population.new("X", as_column(seqs)), random_state=np.random.default_rng(1))
+    assert op.graph(problem.simulator) is graph
+    with pytest.raises(ParameterError, match="tries"):
+        CommandReachRepair(tries=0)

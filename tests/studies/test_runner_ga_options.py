@@ -136,11 +136,40 @@ def test_fastest_gap_needs_the_gap_metric():
 
 
 def test_bundled_ga_replan_study_is_issue_15s_setting():
+    from htetro_opt.scenarios import list_scenarios
+
     study = load_study("ga_replan")
-    assert [s.rsplit("/", 1)[-1] for s in study.scenarios] == ["random", "spiral", "h_shape", "three_slit",
-                                                                "perpendicular_dynamic", "parallel_dynamic"]
-    assert all(load_scenario(s).workspace.moving for s in study.scenarios[-2:])
+    names = [s.rsplit("/", 1)[-1] for s in study.scenarios]
+    assert names == ["random", "spiral", "h_shape", "three_slit", "perpendicular_dynamic", "parallel_dynamic",
+                     "maze", "zigzag"]
+    # every bundled Cheng et al. 2020 (seed 000) map, both moving-obstacle maps among them
+    cheng2020 = {n for n in list_scenarios() if getattr(load_scenario(n), "source", "").startswith("Cheng et al., "
+                                                                                                    "IEEE Access 2020")}
+    assert cheng2020 == set(names[:6])
+    assert all(load_scenario(s).workspace.moving for s in study.scenarios[4:6])
     assert study.seeds == tuple(range(10)) and "gap" in study.metrics and "generations" in study.metrics
     assert [(m.method, dict(m.options)) for m in study.methods] == [("htetro-ga", {"pop_size": 50}),
                                                                      ("htetro-ga-paper", {"pop_size": 50})]
-    assert len(study.trials()) == 120 and len({r.key for r in study.references().values()}) == 6
+    assert len(study.trials()) == 160 and len({r.key for r in study.references().values()}) == 8
+
+
+@pytest.mark.parametrize("method", ["nsga2", "dijkstra"])
+def test_reach_patience_is_the_htetro_gas_option(method):
+    for ga in ("htetro-ga", "htetro-ga-paper"):
+        assert _study(method=ga, reach_patience=0).methods[0].options == {"reach_patience": 0}
+    with pytest.raises(StudyError, match=r"methods\[0\]: reach_patience"):
+        _study(method="htetro-ga", reach_patience=-1)
+    with pytest.raises(StudyError, match=rf"methods\[0\]: reach_patience applies to the .* not to {method}"):
+        _study(method=method, reach_patience=5)
+
+
+def test_reach_patience_reaches_the_planner():
+    # a patience of 1 fires the repair in the first generation without a reach; 0 never does
+    grid = load_scenario("h_shape")
+    options = {**TINY, "max_gen": 3}
+    records = {p: run_trial("plan", "h_shape", "htetro-ga", {**options, "reach_patience": p}, 0) for p in (0, 1)}
+    plans = {p: plan_path(grid.workspace, grid.roadmap, method="htetro-ga", seed=0, reach_patience=p, **options)
+             for p in (0, 1)}
+    for p in (0, 1):
+        assert records[p]["reach_patience"] == p and records[p]["commands"] == ",".join(plans[p].tokens)
+    assert str(plans[0].legs[0].front) != str(plans[1].legs[0].front)

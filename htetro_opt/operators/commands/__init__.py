@@ -11,7 +11,8 @@ takes the ``random_state`` pymoo passes:
 - :mod:`.repair`: ours, optional: invalid commands replaced by valid ones (:class:`CommandRepair`);
 - :mod:`.shortcut`: ours, optional: cut the longest loop of a path (:class:`CommandShortcut`);
 - :mod:`.replan`: ours, optional: replace a window of a path by the minimum-time path between its
-  ends (:class:`CommandReplan`);
+  ends (:class:`CommandReplan`), or the tail of a path that misses the goal by the fastest way to
+  it (:class:`CommandReachRepair`);
 - :mod:`.duplicates`: :class:`CommandDuplicateElimination`;
 - :mod:`.selection`: the size-4 deterministic tournament on rank and crowding;
 - :mod:`.survival`: the goal-reachability sort (:class:`GoalReachabilitySurvival`).
@@ -24,7 +25,14 @@ from htetro_opt.operators.commands.mutation import CommandMutation, mutate_comma
 from htetro_opt.operators.commands.rearrangement import CommandRearrangement, rearrange_commands
 from htetro_opt.operators.commands.repair import CommandRepair
 from htetro_opt.operators.commands.removal import CommandRemoval, remove_commands
-from htetro_opt.operators.commands.replan import CommandReplan, TransitionGraph, replan_rows, replan_windows
+from htetro_opt.operators.commands.replan import (
+    CommandReachRepair,
+    CommandReplan,
+    TransitionGraph,
+    reach_repair,
+    replan_rows,
+    replan_windows,
+)
 from htetro_opt.operators.commands.shortcut import (
     CommandShortcut,
     cut_longest_loop,
@@ -45,7 +53,7 @@ __all__ = [
     "CommandRemoval", "remove_commands",
     "CommandRepair",
     "CommandShortcut", "cut_longest_loop", "longest_loops", "shortcut_sequences", "repair_and_shortcut",
-    "CommandReplan", "TransitionGraph", "replan_rows", "replan_windows",
+    "CommandReplan", "TransitionGraph", "replan_rows", "replan_windows", "CommandReachRepair", "reach_repair",
     "DEFAULT_SAMPLING_WEIGHTS", "CommandSampling", "sample_commands",
     "RankAndCrowdingTournament", "rank_and_crowding_tournament",
     "GoalReachabilitySurvival", "reaches_goal",

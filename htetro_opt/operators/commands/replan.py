@@ -6,6 +6,10 @@ command sequence between the poses before and after it, found by scipy's Dijkstr
 transition table, the search bounded by the window's own time so that it stays local. With moving
 obstacles the search is time-expanded (the obstacles' clock is the number of commands executed, as
 in the simulator), so the new window is valid at the times it runs.
+
+The *reach repair* (:func:`reach_repair`) is the same search with the goal as the window's end: a
+chromosome that does not reach keeps its executed commands up to the pose from which the goal is
+nearest in time, and the minimum-time path from there (at its time) to the goal replaces the rest.
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ from htetro_opt.errors import PlanningError
 from htetro_opt.model.simulate import Simulator
 from htetro_opt.operators.commands._chromosome import as_column, sequences
 
-__all__ = ["CommandReplan", "TransitionGraph", "replan_rows", "replan_windows"]
+__all__ = ["CommandReachRepair", "CommandReplan", "TransitionGraph", "reach_repair", "replan_rows", "replan_windows"]
 
 _TOLERANCE = 1e-9  # times are sums of float durations: an equal time is not an improvement
 _ANSWERS = 1 << 14  # searches :meth:`TransitionGraph.fastest` remembers (a few hundred bytes each)
@@ -140,6 +144,14 @@ class TransitionGraph:
         self._answers[query] = answer
         return answer
 
+    def time_to(self, target: int, *, limit: float = np.inf) -> np.ndarray:
+        """The static minimum time from every pose to pose ``target`` (inf beyond ``limit``): a lower
+        bound on the time-expanded one, as the moving obstacles only remove edges."""
+        if self._reverse is None:
+            self._reverse = self._graph()[0].T.tocsr()
+            self._labels = np.full(self.period * self.n_poses, np.inf)
+        return dijkstra(self._reverse, indices=int(target), limit=limit)
+
     def _static_search(self, source: int, target: int, bound: float) -> list[tuple[np.ndarray, float]]:
         matrix, commands = self._graph()
         dist, pred = dijkstra(matrix, indices=source, return_predecessors=True, limit=bound)
@@ -159,10 +171,7 @@ class TransitionGraph:
         not one per distinct time. The neighbourhood searched is then that of the optimum, not that
         of the window's own time, which may be far larger.
         """
-        if self._reverse is None:
-            self._reverse = self._graph()[0].T.tocsr()
-            self._labels = np.full(self.period * self.n_poses, np.inf)
-        to_go = dijkstra(self._reverse, indices=target, limit=limit)
+        to_go = self.time_to(target, limit=limit)
         floor = float(to_go[source])
         if not floor <= limit:
             return []
@@ -351,6 +360,82 @@ def replan_windows(problem, seqs: list[np.ndarray], *, window: int, random_state
     return out
 
 
+def reach_repair(problem, seqs: list[np.ndarray], *, graph: TransitionGraph | None = None,
+                 tries: int = 3) -> list[np.ndarray]:
+    """Make chromosomes that do not reach the goal reach it: the executed commands up to a pose, then
+    the minimum-time path from that pose (at its time) to the goal.
+
+    Each chromosome is simulated from the problem's start (with its goal and child termination).
+    The poses it passes are ranked by their static minimum time to the goal (a lower bound, on a
+    moving map as well), the nearest first and, of equals, the one passed first; for up to ``tries``
+    distinct poses in that order, the fastest path from the pose to the goal is searched
+    (:meth:`TransitionGraph.fastest`: time-expanded with the obstacles' clock on a moving map, so it
+    is valid at the times it runs), bounded so that the whole path takes at most t_max, the
+    problem's time budget (f_t ≥ 0). The first candidate the simulator confirms to reach the goal
+    replaces the chromosome; a chromosome that already reaches, or for which no candidate does, is
+    returned unchanged. The pose kept is the nearest to the goal rather than the start so that the
+    chromosome's lineage (its route so far) is kept and only its tail is planned.
+
+    Parameters
+    ----------
+    problem : CommandPathProblem
+        Provides ``simulator``, ``start_id``, ``goal``, ``goal_id``, ``t0`` and ``t_max``.
+    seqs : list of ndarray
+        Global command ids.
+    graph : TransitionGraph, optional, keyword-only
+        The problem's simulator's graph, if already built.
+    tries : int, default 3, keyword-only
+        How many distinct poses a chromosome may be cut at.
+
+    Returns
+    -------
+    list of ndarray
+        New arrays where a chromosome was repaired, the input ones elsewhere.
+
+    Raises
+    ------
+    ParameterError
+        If ``tries`` is not a positive integer.
+
+    Examples
+    --------
+    >>> from htetro_opt.model import Pose, Workspace, format_commands, parse_commands
+    >>> from htetro_opt.problems import CommandPathProblem
+    >>> problem = CommandPathProblem(Workspace(np.zeros((8, 8), dtype=bool)), Pose(1, 2, "O", 0),
+    ...                              Pose(5, 2, "O", 0), max_length=10)
+    >>> [s] = reach_repair(problem, [parse_commands("x+,x+,x+,y+,y+")])
+    >>> format_commands(s)
+    ['x+', 'x+', 'x+', 'x+']
+    """
+    tries = check_int(tries, "reach repair tries", minimum=1)
+    out = list(seqs)
+    if not seqs:
+        return out
+    sim = problem.simulator
+    graph = graph if graph is not None else TransitionGraph(sim)
+    result = sim.run(seqs, problem.start_id, roadmap=[problem.goal], t0=problem.t0, stop_at_goal=True)
+    to_go = graph.time_to(problem.goal_id, limit=problem.t_max)
+    durations = sim.durations[result.local]
+    for k in np.flatnonzero(~result.reached.astype(bool)):
+        done = int(result.executed[k])
+        poses = result.trace[k, : done + 1].astype(np.int64)
+        elapsed = np.r_[0.0, np.cumsum(durations[k, :done])]
+        budget = problem.t_max - elapsed
+        order = np.lexsort((np.arange(done + 1), to_go[poses]))  # nearest first, then the first passed
+        order = order[to_go[poses[order]] <= budget[order] * (1 + _TOLERANCE) + _TOLERANCE]
+        _, first = np.unique(poses[order], return_index=True)
+        for i in order[np.sort(first)][:tries]:
+            found = graph.fastest(int(poses[i]), problem.t0 + int(i), problem.goal_id, 0, limit=float(budget[i]))
+            if not found:
+                continue
+            candidate = np.concatenate([seqs[k][:i], found[0][0]]).astype(np.int64)
+            check = sim.run([candidate], problem.start_id, roadmap=[problem.goal], t0=problem.t0, stop_at_goal=True)
+            if check.reached[0] and check.executed[0] == len(candidate):
+                out[k] = candidate
+                break
+    return out
+
+
 def replan_rows(reached, time, members: int, *, random_state: np.random.Generator) -> np.ndarray:
     """The rows a generation re-plans: the fastest goal-reaching one (the first of equals) and
     ``members`` others drawn without replacement among the reaching ones, those in row order.
@@ -419,3 +504,35 @@ class CommandReplan(Mutation):
     def _do(self, problem, X, *args, random_state=None, **kwargs):
         return as_column(replan_windows(problem, sequences(X), window=self.window, random_state=random_state,
                                         graph=self.graph(problem.simulator), timed=self.timed))
+
+
+class CommandReachRepair(Mutation):
+    """The reach repair as a pymoo mutation (see :func:`reach_repair`).
+
+    Ours, not part of the paper's hTetro-GA: the hTetro-GA applies it to the member nearest to the
+    goal when no member has reached it and the population's best goal reachability has not risen for
+    ``reach_patience`` generations (:class:`~htetro_opt.algorithms.HTetroGA`). Builds the
+    :class:`TransitionGraph` of a problem's simulator once and keeps it while the simulator lives. The
+    problem must provide ``simulator``, ``start_id``, ``goal``, ``goal_id``, ``t0`` and ``t_max``.
+
+    Parameters
+    ----------
+    tries : int, default 3, keyword-only
+        How many distinct poses a chromosome may be cut at.
+    prob : float, keyword-only
+        pymoo's per-individual probability that the operator is applied.
+    """
+
+    def __init__(self, *, tries: int = 3, prob: float = 1.0) -> None:
+        super().__init__(prob=check_probability(prob, "reach repair prob"))
+        self.tries = check_int(tries, "reach repair tries", minimum=1)
+        self._graphs: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+    def graph(self, simulator: Simulator) -> TransitionGraph:
+        """The simulator's :class:`TransitionGraph`, built on first use."""
+        if simulator not in self._graphs:
+            self._graphs[simulator] = TransitionGraph(simulator)
+        return self._graphs[simulator]
+
+    def _do(self, problem, X, *args, random_state=None, **kwargs):
+        return as_column(reach_repair(problem, sequences(X), graph=self.graph(problem.simulator), tries=self.tries))

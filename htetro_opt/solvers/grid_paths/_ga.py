@@ -146,6 +146,7 @@ def plan_ga(
     pick: str = "balanced",
     reach_share: float | None = None,
     conservative: bool | None = None,
+    reach_patience: int | None = None,
 ) -> Plan:
     """Plan through a roadmap with a command-chromosome GA, one optimisation per leg.
 
@@ -222,6 +223,13 @@ def plan_ga(
         pymoo's algorithms only: add the hTetro-GA's conservative offspring set (removal,
         rearrangement, shortcut) to their mating (:class:`~htetro_opt.algorithms.ConservativeMating`);
         None: off. Refused for the hTetro-GA, which always makes it.
+    reach_patience : int, optional, keyword-only
+        The hTetro-GA's reach repair (ours; :class:`~htetro_opt.algorithms.HTetroGA`): when no member
+        reaches the goal and the best goal reachability has not risen for this many generations, the
+        member nearest to the goal keeps its commands up to the pose nearest to the goal and gets the
+        minimum-time path from there (:func:`~htetro_opt.operators.commands.reach_repair`). None: the
+        algorithm's default, 100 for ``"htetro-ga"``, off for ``"htetro-ga-paper"``; 0 turns it off.
+        Refused (unless 0) for pymoo's algorithms.
 
     Returns
     -------
@@ -249,7 +257,7 @@ def plan_ga(
     (True, 7.0)
     """
     make_algorithm(algorithm, pop_size, replan_window=replan_window, replan_members=replan_members,
-                   reach_share=reach_share, conservative=conservative)  # validates
+                   reach_share=reach_share, conservative=conservative, reach_patience=reach_patience)  # validates
     seed_exact = check_bool(seed_exact, "seed_exact")
     if not isinstance(pick, str) or pick not in PICKS:
         raise ParameterError(f"pick must be one of {', '.join(PICKS)}, got {pick!r}")
@@ -288,7 +296,7 @@ def plan_ga(
         res = minimize(problem, make_algorithm(algorithm, pop_size, sampling_weights=sampling_weights,
                                                replan_window=replan_window, replan_members=replan_members,
                                                reach_share=reach_share, conservative=conservative,
-                                               include=include),
+                                               include=include, reach_patience=reach_patience),
                        termination, seed=int(leg_seeds[leg]), callback=recorder, verbose=verbose)
         X, F = res.pop.get("X"), res.pop.get("F")
         chosen = select_solutions(F)
