@@ -1,8 +1,9 @@
 """Tetromino tiling of a grid workspace (Le et al. 2018): :func:`tile_workspace` with ``method=``.
 
 ``"backtracking"`` is the paper's search (with region, colouring and memo pruning), ``"cpsat"`` an
-exact cover by OR-Tools' CP-SAT, ``"auto"`` (the default) a portfolio of both and of CP-SAT band by band,
-with budgets counted in steps, so that no map makes it search for long where another method would not. :func:`enumerate_tilings` lists several tilings and
+exact cover by OR-Tools' CP-SAT, ``"auto"`` (the default) a portfolio: the backtracker, a compiled
+sweep repaired by small exact covers, CP-SAT band by band and region by region, with budgets counted
+in steps, so that no map makes it search for long where another method would not. :func:`enumerate_tilings` lists several tilings and
 :func:`find_tiles` returns the bare tiles; a map that cannot be tiled raises a
 :class:`~htetro_opt.errors.TilingError` that says why.
 
@@ -14,5 +15,7 @@ from htetro_opt._lazy import attach
 __getattr__, __dir__, __all__ = attach(__name__, {
     "tile_workspace": "._tiling", "enumerate_tilings": "._tiling", "find_tiles": "._tiling",
     "TILING_METHODS": "._tiling", "AUTO_STEPS": "._tiling", "BAND_ROWS": "._tiling",
-    "BAND_COMMIT": "._tiling", "BAND_WORK": "._tiling",
+    "BAND_COMMIT": "._tiling", "BAND_WORK": "._tiling", "SWEEP_CELLS": "._tiling", "SWEEP_POCKET": "._tiling",
+    "SWEEP_FINAL": "._tiling", "STRIP_LIFTS": "._tiling", "STRIP_STEPS": "._tiling", "REPAIR_BOXES": "._tiling",
+    "REPAIR_WORK": "._tiling", "REPAIR_TRIES": "._tiling",
 })

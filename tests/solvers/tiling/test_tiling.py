@@ -212,8 +212,8 @@ def test_auto_has_no_tail_where_backtracking_has(seed, tileable):
 
 
 @pytest.mark.parametrize("h, w", [(64, 64), (40, 90)])
-def test_auto_bands_tile_scattered_obstacles(h, w):
-    """5 % of the cells blocked at random: the backtracker thrashes, the bands tile (the wide map turned)."""
+def test_auto_tiles_scattered_obstacles(h, w):
+    """5 % of the cells blocked at random: the backtracker thrashes, the repaired sweep tiles."""
     occ = np.random.default_rng(3).random((h, w)) < 0.05
     ys, xs = np.nonzero(~occ)
     occ[ys[:(~occ).sum() % 4], xs[:(~occ).sum() % 4]] = True
@@ -258,8 +258,143 @@ def test_auto_time_limit_says_nothing_was_proven():
     occ = np.random.default_rng(3).random((64, 64)) < 0.05
     ys, xs = np.nonzero(~occ)
     occ[ys[:(~occ).sum() % 4], xs[:(~occ).sum() % 4]] = True
-    with pytest.raises(TilingError, match="none proven impossible within the time limit of 0.2 s"):
-        find_tiles(occ, time_limit=0.2)
+    with pytest.raises(TilingError, match="none proven impossible within the time limit of 0.001 s"):
+        find_tiles(occ, time_limit=1e-3)
+
+
+def scattered(h, w, density, seed, blocks=False):
+    """The maps of benchmarks/bench_tiling.py: map_cells (each cell blocked with probability
+    ``density``) or, with ``blocks``, map_blocks (``density`` random blocks of up to 3 x 3)."""
+    rng = np.random.default_rng(seed)
+    if blocks:
+        occ = np.zeros((h, w), dtype=bool)
+        for _ in range(density):
+            x, y = rng.integers(0, w), rng.integers(0, h)
+            occ[y:y + rng.integers(1, 4), x:x + rng.integers(1, 4)] = True
+    else:
+        occ = rng.random((h, w)) < density
+    ys, xs = np.nonzero(~occ)
+    occ[ys[:(~occ).sum() % 4], xs[:(~occ).sum() % 4]] = True
+    return occ
+
+
+@pytest.mark.parametrize("density, seed, blocks", [(0.05, 1, False), (0.05, 4, False), (0.1, 0, False),
+                                                   (150, 2, True), (150, 5, True)])
+def test_auto_has_no_tail_on_scattered_64x64(density, seed, blocks):
+    """The 64 x 64 maps auto took 6-19 s on before the sweep (CP-SAT 14-30 s+, backtracking 30 s+):
+    tiled within 5 s, as an exact cover."""
+    occ = scattered(64, 64, density, seed, blocks)
+    assert_exact_cover(occ, find_tiles(occ, time_limit=5))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("density, seed, blocks", [(0.05, 0, False), (0.05, 1, False), (400, 0, True)])
+def test_auto_tiles_128x128_with_obstacles(density, seed, blocks):
+    """128 x 128 maps that no method tiled within 60 s before the sweep: within 10 s now."""
+    occ = scattered(128, 128, density, seed, blocks)
+    assert_exact_cover(occ, find_tiles(occ, time_limit=10))
+
+
+def test_auto_is_reproducible_on_scattered_maps():
+    """Every budget of the sweep's repairs is counted in steps or deterministic time: one tiling per
+    map and seed, and shuffled seeds give others."""
+    occ = scattered(64, 64, 0.05, 1)
+    assert tiling_key(find_tiles(occ)) == tiling_key(find_tiles(occ))
+    shuffled = [tiling_key(find_tiles(occ, shuffle=True, seed=s)) for s in (0, 0, 1)]
+    assert shuffled[0] == shuffled[1] != shuffled[2]
+
+
+@pytest.fixture
+def small_sweep(monkeypatch):
+    """No backtracking stage and the sweep on small maps, with small repair boxes and final strip,
+    and a record of the tilings the sweep returned (a test that never saw one would prove nothing)."""
+    import htetro_opt.solvers.tiling._tiling as module
+
+    monkeypatch.setattr(module, "AUTO_STEPS", (0, 0))
+    monkeypatch.setattr(module, "SWEEP_CELLS", 0)
+    monkeypatch.setattr(module, "SWEEP_FINAL", 2)
+    monkeypatch.setattr(module, "STRIP_LIFTS", (0, 1, 3))
+    monkeypatch.setattr(module, "REPAIR_BOXES", ((1, 2), (2, 3)))
+    swept = []
+    sweep_tiling = module._sweep_tiling
+
+    def spy(*args):
+        tiles = sweep_tiling(*args)
+        swept.append(tiles is not None)
+        return tiles
+
+    monkeypatch.setattr(module, "_sweep_tiling", spy)
+    return swept
+
+
+@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow,
+                                                                 HealthCheck.function_scoped_fixture])
+@given(data=st.data(), w=st.integers(4, 7), h=st.integers(4, 7),
+       shapes=st.sampled_from([None, None, "TZ", "IT", "LJT", "SZ", "T"]))
+def test_sweep_stage_agrees_with_naive_search(small_sweep, data, w, h, shapes):
+    """The sweep with its repairs and final strip, then the later stages where it gives up: a tiling
+    exactly when an unpruned search finds one, and every tiling an exact cover."""
+    obstacles = data.draw(st.sets(st.integers(0, w * h - 1), max_size=w * h // 6))
+    occ = np.zeros(w * h, dtype=bool)
+    occ[list(obstacles)] = True
+    occ = occ.reshape(h, w)
+    ys, xs = np.nonzero(~occ)
+    occ[ys[:(~occ).sum() % 4], xs[:(~occ).sum() % 4]] = True
+    truth = (~occ).any() and naive_tileable(occ, shapes)
+    try:
+        tiles = find_tiles(occ, shapes=shapes)
+    except TilingError as err:
+        assert not truth and "time limit" not in str(err)
+    else:
+        assert truth
+        assert_exact_cover(occ, tiles, shapes)
+
+
+def test_the_sweep_stage_tiles_small_maps(small_sweep):
+    """The hypothesis test above is only worth something if the sweep itself tiles some maps."""
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        occ = rng.random((8, 8)) < 0.1
+        ys, xs = np.nonzero(~occ)
+        occ[ys[:(~occ).sum() % 4], xs[:(~occ).sum() % 4]] = True
+        try:
+            assert_exact_cover(occ, find_tiles(occ))
+        except TilingError:
+            pass
+    assert sum(small_sweep) >= 5, small_sweep
+
+
+@pytest.fixture
+def regions_only(monkeypatch):
+    """No backtracking stage and no sweep: CP-SAT region by region decides (maps too small for bands)."""
+    import htetro_opt.solvers.tiling._tiling as module
+
+    monkeypatch.setattr(module, "AUTO_STEPS", (0, 0))
+    monkeypatch.setattr(module, "SWEEP_CELLS", 10 ** 9)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow,
+                                                                 HealthCheck.function_scoped_fixture])
+@given(data=st.data(), w=st.integers(3, 5), h=st.integers(4, 7),
+       shapes=st.sampled_from([None, "TZ", "IT", "LJT", "T"]))
+def test_region_by_region_agrees_with_naive_search(regions_only, data, w, h, shapes):
+    """Two regions side by side (a wall between them), each tiled on its own."""
+    obstacles = data.draw(st.sets(st.integers(0, 2 * w * h - 1), max_size=w * h // 3))
+    occ = np.zeros(2 * w * h, dtype=bool)
+    occ[list(obstacles)] = True
+    occ = occ.reshape(h, 2 * w)
+    occ = np.concatenate([occ[:, :w], np.ones((h, 1), dtype=bool), occ[:, w:]], axis=1)
+    for part in (occ[:, :w], occ[:, w + 1:]):  # views: each region's area a multiple of 4
+        ys, xs = np.nonzero(~part)
+        part[ys[:(~part).sum() % 4], xs[:(~part).sum() % 4]] = True
+    truth = (~occ).any() and naive_tileable(occ, shapes)
+    try:
+        tiles = find_tiles(occ, shapes=shapes)
+    except TilingError as err:
+        assert not truth and "time limit" not in str(err)
+    else:
+        assert truth
+        assert_exact_cover(occ, tiles, shapes)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -496,10 +631,11 @@ def test_tile_workspace_accepts_a_workspace_or_an_array():
 
 
 def test_importing_the_tiler_imports_neither_pymoo_nor_deap():
+    """Nor numba, which only the sweep of auto needs (its import alone takes about half a second)."""
     import subprocess
     import sys
 
     code = ("import sys, htetro_opt.solvers.tiling as t; t.tile_workspace; "
-            "print(sorted(m for m in ('pymoo', 'deap') if m in sys.modules))")
+            "print(sorted(m for m in ('pymoo', 'deap', 'numba') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]"
