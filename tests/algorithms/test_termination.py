@@ -1,4 +1,4 @@
-"""FrontConvergence: counting generations without improvement, the cap, and what a run reports."""
+"""FrontConvergence and HypervolumeWindow: when they stop, the cap, and what a run reports."""
 
 from types import SimpleNamespace
 
@@ -8,6 +8,7 @@ from pymoo.core.population import Population
 from pymoo.optimize import minimize
 
 from htetro_opt.algorithms import ConvergenceRecorder, FrontConvergence, HTetroGA
+from htetro_opt.algorithms.termination import HypervolumeWindow
 from htetro_opt.errors import ParameterError
 from htetro_opt.model import Pose, Workspace
 from htetro_opt.problems import CommandPathProblem
@@ -143,3 +144,85 @@ def test_the_best_measure_counts_what_the_hypervolume_one_ignores():
 def test_an_unknown_measure_is_refused(measure):
     with pytest.raises(ParameterError, match="measure"):
         FrontConvergence(measure=measure)
+
+
+def one_member(f_t, f_sm, f_sf, f_gr=1.0):
+    """A population of one individual, as pymoo's F = −fitness; its reaching HV is f_t·f_sm·f_sf."""
+    return -np.array([[f_gr, f_t, f_sm, f_sf]])
+
+
+def stop_generation(term, populations):
+    """The first generation (1-based) after which ``term`` has terminated, or None."""
+    for gen, F in enumerate(populations, start=1):
+        term.update(fake_algorithm(F, gen))
+        if term.has_terminated():
+            return gen
+    return None
+
+
+def test_hypervolume_window_stops_once_the_front_has_not_moved_for_a_window():
+    # reached from generation 3 on; the front then stands still: the window of 4 needs 5 reaching
+    # generations (the newest against the one 4 before), so the run stops at generation 3 + 4
+    populations = [one_member(0.5, 0.5, 0.5, f_gr=0.5)] * 2 + [one_member(0.5, 0.5, 0.5)] * 20
+    term = HypervolumeWindow(max_gen=100, window=4)
+    assert stop_generation(term, populations) == 7
+    assert term.converged
+
+
+def test_hypervolume_window_keeps_going_while_the_front_moves():
+    # the safety of the one member rises by 1 % a generation: 4 % over the window, far above 1e-3
+    populations = [one_member(0.5, 0.5, 0.5 * 1.01 ** gen) for gen in range(30)]
+    term = HypervolumeWindow(max_gen=30, window=4, tolerance=1e-3)
+    assert stop_generation(term, populations) == 30
+    assert not term.converged  # stopped by the cap
+
+
+def test_hypervolume_window_a_creeping_front_within_tolerance_stops():
+    # 0.01 % a generation is 0.04 % over the window: below a tolerance of 1e-3, above one of 1e-4
+    populations = [one_member(0.5, 0.5, 0.5 * 1.0001 ** gen) for gen in range(30)]
+    assert stop_generation(HypervolumeWindow(max_gen=30, window=4, tolerance=1e-3), populations) == 5
+    assert stop_generation(HypervolumeWindow(max_gen=30, window=4, tolerance=1e-4), populations) == 30
+
+
+def test_hypervolume_window_a_faster_path_always_counts():
+    # the best time rises by 1e-6 a generation while the other two fall so that the hypervolume
+    # does not rise at all: any faster path is movement, whatever the tolerance
+    populations = [one_member(0.5 + 1e-6 * gen, 0.5, 0.5 * 0.5 / (0.5 + 1e-6 * gen)) for gen in range(20)]
+    term = HypervolumeWindow(max_gen=20, window=4, tolerance=0.5)
+    assert stop_generation(term, populations) == 20 and not term.converged
+
+
+def test_hypervolume_window_a_step_restarts_the_wait_and_a_drop_is_no_step():
+    # still for 6 generations, one 10 % step at generation 7, then still; a generation whose front
+    # shrinks (crowding swapping members) neither moves it nor resets the best-so-far
+    hv = [0.5] * 6 + [0.55] * 3 + [0.4] + [0.55] * 10
+    populations = [one_member(0.5, 0.5, v) for v in hv]
+    assert stop_generation(HypervolumeWindow(max_gen=100, window=4), populations[:6]) == 5
+    assert stop_generation(HypervolumeWindow(max_gen=100, window=4), populations[4:]) == 7  # gens 5..11
+    assert stop_generation(HypervolumeWindow(max_gen=100, window=8), populations) == 15  # step at 7, + 8
+
+
+def test_hypervolume_window_waits_for_the_goal():
+    term = HypervolumeWindow(max_gen=6, window=1)
+    unreached = [one_member(1.0, 1.0, 1.0, f_gr=0.5)] * 6
+    assert stop_generation(term, unreached) == 6 and not term.converged
+    algorithm = fake_algorithm(unreached[0], 6)
+    term.update(algorithm)
+    assert algorithm.data["converged"] is False
+
+
+@pytest.mark.parametrize("options", [dict(max_gen=0), dict(max_gen=2.5), dict(window=0), dict(window=-3),
+                                     dict(window=1.0), dict(window=True), dict(window=None),
+                                     dict(tolerance=-1e-3), dict(tolerance=float("nan")),
+                                     dict(tolerance=float("inf")), dict(tolerance="0.1")])
+def test_hypervolume_window_parameters(options):
+    with pytest.raises(ParameterError, match=next(iter(options))):
+        HypervolumeWindow(**options)
+
+
+def test_hypervolume_window_runs_are_deterministic_and_report_convergence(small_problem):
+    runs = [minimize(small_problem, HTetroGA(pop_size=12), HypervolumeWindow(max_gen=300, window=5), seed=4)
+            for _ in range(2)]
+    assert all(res.data["converged"] is True for res in runs)
+    assert runs[0].algorithm.n_gen == runs[1].algorithm.n_gen < 300
+    np.testing.assert_array_equal(runs[0].pop.get("F"), runs[1].pop.get("F"))
