@@ -5,7 +5,8 @@
 - :func:`make_algorithm`: that or one of pymoo's algorithms by name (:data:`GA_ALGORITHMS`), with the
   same operators;
 - :class:`FrontConvergence`: stop at a generation cap or when the goal-reaching front stops improving
-  (by its best fitnesses, or by its best time and :func:`reaching_hypervolume`);
+  (by its best fitnesses, or by its best time and :func:`reaching_hypervolume`); :class:`HypervolumeWindow`:
+  the same over a sliding window of generations (measured, not a default);
 - :func:`leading_front`, :func:`select_solutions`, :class:`ConvergenceRecorder`: the paper's output
   solutions and their convergence record;
 - :class:`EnhancedGA`, :func:`make_path_algorithm` (Nazarahari et al. 2019): the enhanced GA over
@@ -16,7 +17,7 @@ from htetro_opt._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
     "HTetroGA": ".htetro_ga", "trim_reached": ".htetro_ga",
-    "FrontConvergence": ".termination", "CONVERGENCE_MEASURES": ".termination", "reaching_hypervolume": ".termination",
+    "FrontConvergence": ".termination", "HypervolumeWindow": ".termination", "CONVERGENCE_MEASURES": ".termination", "reaching_hypervolume": ".termination",
     "GA_ALGORITHMS": ".factory", "make_algorithm": ".factory", "ReplanMating": ".factory",
     "ConservativeMating": ".factory",
     "SELECTIONS": ".solutions", "PICKS": ".solutions", "leading_front": ".solutions", "select_solutions": ".solutions",
