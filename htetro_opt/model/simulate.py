@@ -4,10 +4,12 @@ A :class:`Simulator` compiles, once per workspace, command set, timing and clear
 table ``next[pose, command]``: poses are the flat ids ``((state * 4 + heading) * H + y) * W + x``,
 ``next`` holds the pose after the command or ``dead`` where the command's swept cells are not all
 inside the map and free, and an extra ``pad`` command leaves every pose unchanged. Simulating a batch
-is then one add and one gather per step for the whole batch: the table is kept premultiplied by its
-column count, so a gathered value plus the next command is the next index. Moving obstacles add, per
-time step, a sorted array of blocked ``pose * n_columns + command`` keys (the swept-cell table turned
-inside out), checked with one ``searchsorted`` per step. :func:`transitions_at` gives the table's rows
+is then one add and one gather per sequence and step, in a loop compiled by numba (:func:`_walk`; as
+numpy calls on the whole batch, a step cost a few microseconds of call overhead whatever the batch,
+and a repairing step several times that): the table is kept premultiplied by its column count, so a
+gathered value plus the next command is the next index. Moving obstacles add, per time step, a
+sorted array of blocked ``pose * n_columns + command`` keys (the swept-cell table turned inside out),
+searched once per sequence and step. :func:`transitions_at` gives the table's rows
 at some cells only, from the same sweep check, for maps whose whole table would not fit in memory.
 
 Time for moving obstacles is the number of commands executed (MODEL.md §5): command number t (from 0,
@@ -53,6 +55,98 @@ A map that would need more is refused before anything is allocated, with what wo
 
 _ROWS_PER_SORT = 1 << 16
 """Poses whose valid commands the repair sorts at a time (bounds the sort's temporary arrays)."""
+
+def _compiled_walk():
+    """:func:`_walk` compiled by numba, on its first use.
+
+    Compiled here rather than at import so that importing the model (the tiler, the scenario
+    loader, the CLI's start) does not pay numba's import, about half a second; numba's on-disk cache
+    makes later processes load the compiled loop instead of compiling it. Without numba the loop
+    runs as Python, with the same results.
+    """
+    global _blocked_at, _walk_kernel
+    if _walk_kernel is None:
+        try:
+            import numba
+        except ImportError:  # pragma: no cover - numba is a core dependency
+            _walk_kernel = _walk
+        else:
+            jit = numba.njit(cache=True, nogil=True)
+            _blocked_at = jit(_blocked_at)  # _walk calls it by this global name, so it must be compiled first
+            _walk_kernel = jit(_walk)
+    return _walk_kernel
+
+
+_walk_kernel = None
+
+
+def _blocked_at(blocked, lo, hi, key):
+    """Whether ``key`` is among the sorted ``blocked[lo:hi]``."""
+    i = lo + np.searchsorted(blocked[lo:hi], key)
+    return i < hi and blocked[i] == key
+
+
+def _walk(keys, steps, lengths, flat, table, n_commands, dead_key, blocked, offsets, t0, repair, u, used, t):
+    """The hot loop of :meth:`Simulator._step_all`, compiled: steps ``t``, ``t + 1``, … of the batch;
+    returns the next step to run (``len(steps)`` when done) and the draws of ``u`` used.
+
+    A step is, for each sequence in row order, ``key' = flat[key + command]``, dead where a moving
+    obstacle blocks ``key + command`` (``blocked[offsets[p]:offsets[p + 1]]``, sorted, at the phase
+    p = (t0 + t) mod the period, ``len(offsets) − 1``). With
+    ``repair``, a command that kills a live sequence is replaced as :meth:`Simulator.run` documents:
+    where no obstacle moves at that step, by the ⌊u·n⌋-th of the pose's n valid columns (``table``,
+    see :attr:`Simulator._valid_columns`; one draw, none when n = 0); where one does, by the valid
+    command of largest draw among one draw per command (n_commands draws, whether or not any is
+    valid). The draws are taken from ``u`` in order, so in step order, then row order: the order in
+    which the numpy loop this replaced drew them from the generator. The loop stops early, before a
+    step, when ``u`` might not hold that step's draws; the caller refills it and calls again.
+    """
+    width, batch = steps.shape
+    period = len(offsets) - 1
+    while t < width:
+        if t % 8 == 0 and t:
+            live = False
+            for r in range(batch):
+                if keys[t, r] != dead_key and lengths[r] > t:
+                    live = True
+                    break
+            if not live:  # every sequence has died or ended: nothing changes any more
+                for s in range(t + 1, width + 1):
+                    keys[s] = keys[t]
+                return width, used
+        phase = (t0 + t) % period
+        lo, hi = offsets[phase], offsets[phase + 1]
+        if repair and len(u) - used < batch * (n_commands if hi > lo else 1):
+            return t, used
+        for r in range(batch):
+            here = keys[t, r]
+            index = here + steps[t, r]
+            after = flat[index]
+            if hi > lo and _blocked_at(blocked, lo, hi, index):
+                after = dead_key
+            if repair and after == dead_key and here != dead_key:
+                if hi > lo:  # the static table does not know the moving obstacles: test every command
+                    best, best_u = 0, -2.0
+                    for c in range(n_commands):
+                        key = here + c
+                        value = u[used + c] if flat[key] != dead_key and not _blocked_at(blocked, lo, hi, key) else -1.0
+                        if value > best_u:  # the first of equals, as argmax
+                            best, best_u = c, value
+                    used += n_commands
+                    if best_u >= 0.0:
+                        steps[t, r] = best
+                        after = flat[here + best]
+                else:
+                    n_valid = table[here + n_commands]
+                    if n_valid > 0:
+                        pick = table[here + int(u[used] * n_valid)]
+                        used += 1
+                        steps[t, r] = pick
+                        after = flat[here + pick]
+            keys[t + 1, r] = after
+        t += 1
+    return t, used
+
 
 _BUDGET_TEXT = "the smaller of htetro_opt.model.simulate.MEMORY_BUDGET and half the physical memory"
 
@@ -158,8 +252,8 @@ def compile_bytes(n_poses: int, n_commands: int, *, repair: bool = True) -> int:
     entries) and, from the first run, the table premultiplied by its column count, one more table of
     the same size; plus, per pose and command, one byte of the bool validity table the table is built
     from or, with ``repair`` (runs that repair, as the GAs' do), the two bytes of every pose's valid
-    commands (int16), sorted a slice of poses at a time (tests/model/test_simulate.py compares this
-    with tracemalloc's peak).
+    commands and of their count (int16), sorted a slice of poses at a time
+    (tests/model/test_simulate.py compares this with tracemalloc's peak).
 
     Examples
     --------
@@ -572,9 +666,13 @@ class Simulator:
         """The hot loop: keys ``pose * n_columns`` after each step, shape (L + 1, B), and the (B, L)
         local commands as run (``local`` itself unless ``repair`` changed some).
 
-        Each step is one add and one gather for the whole batch; moving obstacles add one
-        ``searchsorted``. With ``repair``, a command that kills a live sequence is replaced by a valid
-        one (:meth:`_repair_step`); padding never dies, so it is never repaired.
+        Each step is one gather per sequence, compiled (:func:`_walk`); moving obstacles add a
+        binary search among the keys they block at that step. With ``repair``, a command that kills
+        a live sequence is replaced by a valid one; padding never dies, so it is never repaired.
+        The repair's draws come from ``repair`` in step order, then row order: :func:`_walk` takes
+        them from a buffer drawn ahead, and the generator is then moved on by exactly the draws
+        used (its state restored, the used draws drawn again), so it ends where drawing them one
+        step at a time would leave it.
         """
         batch, width = local.shape
         flat = self._flat_next
@@ -582,64 +680,49 @@ class Simulator:
         steps = np.array(local.T, dtype=flat.dtype, order="C")  # (L, B): a contiguous row per step, a copy repair may change
         keys = np.empty((width + 1, batch), dtype=flat.dtype)
         keys[0] = start_key
-        index = np.empty(batch, dtype=flat.dtype)
-        add, take = np.add, flat.take
-        moving = bool(self.workspace.moving)
-        blocked = None
-        for t in range(width):
-            if t % 8 == 0 and t and not ((keys[t] != dead_key) & (lengths > t)).any():
-                keys[t + 1 :] = keys[t]  # every sequence has died or ended: nothing changes any more
-                break
-            add(keys[t], steps[t], out=index)
-            take(index, out=keys[t + 1])
-            if moving:
-                blocked = self.blocked_keys(t0 + t)
-                if len(blocked):
-                    at = np.searchsorted(blocked, index).clip(max=len(blocked) - 1)
-                    keys[t + 1][blocked[at] == index] = dead_key
+        offsets, blocked = self._blocked_by_phase
+        table = self._valid_columns if repair is not None else np.zeros(1, dtype=np.int16)
+        lengths = np.asarray(lengths, dtype=np.int64)
+        per_row = self.n_commands if len(blocked) else 1  # the most draws a sequence takes at a step
+        t, u = 0, np.zeros(0)
+        while t < width:
             if repair is not None:
-                self._repair_step(t, steps, keys, blocked, repair)
+                state = repair.bit_generator.state
+                u = repair.random(max(4096, 4 * batch * per_row))
+                repair.bit_generator.state = state
+            t, used = _compiled_walk()(keys, steps, lengths, flat, table, self.n_commands, dead_key, blocked, offsets,
+                            t0, repair is not None, u, 0, t)
+            if used:
+                repair.random(used)  # the generator moves on by the draws the steps took
         if repair is None:
             return keys, local
         return keys, steps.T.astype(np.int64)
 
     @cached_property
-    def _valid_columns(self) -> tuple[np.ndarray, np.ndarray]:
-        """Per pose, its valid command columns first (``(n_poses, C)``) and how many there are."""
-        order = np.empty((self.n_poses, self.n_commands), dtype=np.int16)
-        counts = np.empty(self.n_poses, dtype=np.int16)
-        table, step = self.next[: self.n_poses, : self.n_commands], _ROWS_PER_SORT
-        for lo in range(0, self.n_poses, step):  # in slices: argsort's int64 result is 4 times the int16 kept
-            invalid = table[lo : lo + step] == self.dead
-            order[lo : lo + step] = np.argsort(invalid, axis=1, kind="stable")
-            counts[lo : lo + step] = self.n_commands - invalid.sum(axis=1)
-        return order, counts
+    def _blocked_by_phase(self) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`blocked_keys` of every phase of the obstacles' period, end to end, and where each
+        phase's begin (``offsets[phase]:offsets[phase + 1]``); one empty phase on a static map."""
+        period = self.workspace.period if self.workspace.moving else 1
+        per_phase = [self.blocked_keys(p) for p in range(period)] if self.workspace.moving else []
+        offsets = np.zeros(period + 1, dtype=np.int64)
+        offsets[1:] = np.cumsum([len(b) for b in per_phase]) if per_phase else 0
+        blocked = np.concatenate(per_phase).astype(np.int64) if per_phase else np.zeros(0, dtype=np.int64)
+        return offsets, blocked
 
-    def _repair_step(self, t: int, steps: np.ndarray, keys: np.ndarray, blocked: np.ndarray | None,
-                     rng: np.random.Generator) -> None:
-        """Replace, in place, step t's commands that killed a live sequence by one drawn uniformly
-        from the commands valid there, and redo their step; a sequence dies only where none is."""
-        flat = self._flat_next
-        dead_key = self.dead * self.n_columns
-        bad = np.flatnonzero((keys[t + 1] == dead_key) & (keys[t] != dead_key))
-        if not len(bad):
-            return
-        here = keys[t][bad]
-        if blocked is None or not len(blocked):
-            n_valid = self._valid_columns[1][here // self.n_columns]
-            bad, here, n_valid = bad[n_valid > 0], here[n_valid > 0], n_valid[n_valid > 0]
-            draw = (rng.random(len(bad)) * n_valid).astype(np.int64)
-            pick = self._valid_columns[0][here // self.n_columns, draw].astype(flat.dtype)
-        else:  # the static table does not know the moving obstacles: test every command
-            candidates = here[:, None] + np.arange(self.n_commands, dtype=flat.dtype)[None, :]
-            ok = flat[candidates] != dead_key
-            at = np.searchsorted(blocked, candidates).clip(max=len(blocked) - 1)
-            ok &= blocked[at] != candidates
-            pick = np.where(ok, rng.random(ok.shape), -1.0).argmax(axis=1).astype(flat.dtype)
-            fixable = ok.any(axis=1)
-            bad, here, pick = bad[fixable], here[fixable], pick[fixable]
-        steps[t, bad] = pick
-        keys[t + 1, bad] = flat[here + pick]
+    @cached_property
+    def _valid_columns(self) -> np.ndarray:
+        """The repair's table, laid out like the keys: row ``pose`` (``(n_poses + 1, n_columns)``, the
+        last row the dead pose's) holds the pose's valid command columns first and, in its last
+        column, how many there are; so with key = pose * n_columns, ``table.take(key + n_commands)``
+        is the count and ``table.take(key + j)`` the j-th valid column, without a division."""
+        n, c = self.n_poses, self.n_commands
+        table = np.zeros((n + 1, self.n_columns), dtype=np.int16)  # the dead pose: no valid command
+        rows, nxt, step = table[:n], self.next[:n, :c], _ROWS_PER_SORT
+        for lo in range(0, n, step):  # in slices: argsort's int64 result is 4 times the int16 kept
+            invalid = nxt[lo : lo + step] == self.dead
+            rows[lo : lo + step, :c] = np.argsort(invalid, axis=1, kind="stable")
+            rows[lo : lo + step, c] = c - invalid.sum(axis=1)
+        return table.ravel()
 
     def _summarise(self, keys, local, lengths, goal_keys, stop_at_goal) -> SimulationResult:
         """Per-sequence outcome from the (L + 1, B) keys of a run."""
