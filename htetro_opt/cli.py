@@ -13,6 +13,7 @@ import os
 import signal
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Sequence
 
@@ -48,7 +49,8 @@ __all__ = ["main", "main_entry", "build_parser"]
 
 EXIT_ERROR = 2
 GA_DEFAULTS = {"pop_size": 50, "max_gen": 1000, "patience": None, "converge": "best", "max_length": None, "seed": 0,
-               "replan_window": None, "replan_members": None, "seed_exact": False, "pick": "balanced"}
+               "replan_window": None, "replan_members": None, "seed_exact": False, "pick": "balanced",
+               "reach_patience": None}
 """Defaults of ``plan``'s GA options (None in the parser, so that one given to an exact method is refused;
 None here: plan_ga's default for the algorithm)."""
 GA_PICKS = ("balanced", "fastest", "smoothest", "safest")  # htetro_opt.algorithms.PICKS, without loading pymoo
@@ -114,6 +116,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--replan-members", type=int, metavar="K",
                    help="GA methods: random goal-reaching members re-planned each generation besides the fastest "
                         "(default 3)")
+    p.add_argument("--reach-patience", type=int, metavar="N",
+                   help="htetro-ga: reach repair of ours, when no member has reached the goal and the best goal "
+                        "reachability has not risen for N generations, the member nearest to the goal gets the "
+                        "minimum-time path to it (default 100; off (0) in htetro-ga-paper)")
     p.add_argument("--seed-exact", action="store_true", default=None,
                    help="GA methods: put each leg's exact minimum-time plan into its initial population; the JSON "
                         "then reports the gaps to the exact optimum")
@@ -179,8 +185,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("scenario", help="bundled scenario name or path to a scenario TOML file")
     p.add_argument("--shapes", help="allowed morphologies, e.g. TZ or O (default: all seven, IOLJZST)")
     p.add_argument("--method", choices=TILING_METHODS, default="auto",
-                   help="auto (default): backtracking for a few steps, then CP-SAT band by band, then CP-SAT "
-                        "on the whole map; backtracking: the paper's search; cpsat: exact cover with OR-Tools CP-SAT")
+                   help="auto (default): backtracking for a few steps, then a compiled sweep repaired by small "
+                        "exact covers, then CP-SAT band by band, then region by region; backtracking: the paper's "
+                        "search; cpsat: exact cover with OR-Tools CP-SAT")
     p.add_argument("--overlap", action="store_true",
                    help="if the map cannot be tiled, cover it by two overlapping sub-workspaces (the paper's Fig. 5)")
     p.add_argument("--shuffle", action="store_true",
@@ -275,6 +282,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--region-columns", type=int, default=4, help="columns of a region (default 4)")
     p.add_argument("--budget", type=int, default=20_000,
                    help="search nodes per region before its greedy walk is taken (default 20000)")
+    p.add_argument("--ends", choices=("sweep", "both"), default="sweep",
+                   help="stripe methods: leave a stripe at its sweep's far end (sweep, default) or at either end "
+                        "(both: every stripe swept either way, or out and back; never costlier)")
     p.add_argument("--start", choices=("scenario", "auto"), default="scenario",
                    help="scenario (default): the roadmap's first pose as start and last as goal (auto when the "
                         "scenario has none); auto: the bottom-left pose of the first layer, a free end")
@@ -407,6 +417,7 @@ _CONTINUOUS_FLAGS = {"path": "--path", "normalise": "--normalise", "safety": "--
                      "robot_radius": "--robot-radius", "time_limit": "--time-limit"}
 _GRID_FLAGS = {"patience": "--patience", "converge": "--converge", "max_length": "--max-length",
                "replan_window": "--replan-window", "replan_members": "--replan-members", "seed_exact": "--seed-exact",
+               "reach_patience": "--reach-patience",
                "pick": "--pick", "diagonals": "--diagonals", "t_max": "--t-max", "element": "--element",
                "no_monotone": "--no-monotone", "band": "--band", "sensor_range": "--sensor-range", "gif": "--gif"}
 
@@ -563,7 +574,7 @@ def _cmd_plan(args) -> dict:
                        max_length=check_int(args.max_length, "--max-length", minimum=1, allow_none=True),
                        seed=check_int(args.seed, "--seed", minimum=0),
                        seed_exact=bool(args.seed_exact), pick=args.pick)
-        for name in ("replan_window", "replan_members"):  # None: the algorithm's default
+        for name in ("replan_window", "replan_members", "reach_patience"):  # None: the algorithm's default
             if getattr(args, name) is not None:
                 options[name] = check_int(getattr(args, name), "--" + name.replace("_", "-"), minimum=0)
     else:
@@ -899,8 +910,8 @@ def _cmd_sequence(args) -> dict:
         name = Path(args.tileset).stem  # the name the user gave, never an install path
     instance = SequencingInstance.from_tileset(tileset, start=start, weights=weights)
     if args.closed or end is not None:
-        instance = SequencingInstance(instance.cost, instance.blocks, instance.start, instance.ids, instance.shape,
-                                      closed=args.closed, end=_index_of(end, instance.ids, "--end", "tile"))
+        instance = replace(instance, closed=args.closed,  # keeps an implicit instance's weights
+                           end=_index_of(end, instance.ids, "--end", "tile"))
     options = _sequence_options(args, instance)
     with console.step(f"sequencing {instance.n} waypoints ({args.method})") as progress:
         result = sequence_waypoints(instance, method=args.method, seed=seed, time_limit=time_limit, progress=progress,
@@ -1168,7 +1179,7 @@ def _cmd_cover(args) -> dict:
     with console.step(f"covering ({args.method})"):
         plan = plan_coverage(scenario.workspace, args.shapes, method=args.method, stripes=args.stripes, start=start,
                              goal=goal, region_columns=region_columns, budget=budget, clearance=clearance,
-                             time_limit=time_limit)
+                             time_limit=time_limit, ends=args.ends)
     out = {"scenario": scenario.name, **plan.as_dict()}
     title = f"{scenario.name}: {args.method}"
     if args.plot:

@@ -1047,7 +1047,8 @@ def test_cover_json_keys_and_replay(capsys):
     assert {"scenario", "method", "shapes", "stripes", "start", "goal", "complete", "free", "coverable", "covered",
             "uncoverable", "action_cost", "time", "commands", "coverage_pct", "recovered_pct", "average_coverage_time",
             "coverable_pct", "path_length", "switches", "turns", "regions", "regions_optimal", "mopup_commands",
-            "stripes_detail", "time_limited", "runtime_s"} <= set(out)
+            "stripes_detail", "time_limited", "ends", "runtime_s"} <= set(out)
+    assert out["ends"] == "sweep"
     assert out["coverable_pct"] == 100.0 and 0 < out["recovered_pct"] < 100
     # every command covers 4 cells' worth of pixels for one unit: the average over the free cells follows
     assert out["average_coverage_time"] == pytest.approx(4 * out["time"] / out["free"], rel=0.01)
@@ -1083,10 +1084,21 @@ def test_cover_boustrophedon_and_auto_start(capsys):
     (["--time-limit", "0"], ["--time-limit"]),
     (["--shapes", "hI"], ["start", "--shapes"]),  # the roadmap's start is an O
     (["--method", "zigzag"], ["zigzag"]),
+    (["--ends", "start"], ["--ends", "start"]),
     (["--method", "tiling-tsp"], ["103 cells"]),  # not a multiple of 4: TilingError
 ])
 def test_cover_bad_options(capsys, argv, words):
     assert_one_error_line(*run(capsys, ["cover", "coverage_16x7", *argv]), *words)
+
+
+def test_cover_ends_both_is_recorded_and_never_costlier(capsys):
+    argv = ["cover", "coverage_16x7", "--shapes", "O,hI", "--stripes", "2,3,2", "--json"]
+    sweep = run_json(capsys, argv)
+    both = run_json(capsys, [*argv, "--ends", "both"])
+    assert both["ends"] == "both" and sweep["ends"] == "sweep"
+    assert both["action_cost"] <= sweep["action_cost"] and both["covered"] == sweep["covered"]
+    replay = run_json(capsys, ["simulate", "coverage_16x7", "--commands", ",".join(both["commands"]), "--json"])
+    assert replay["valid"] is True and replay["time"] == pytest.approx(both["time"])
 
 
 def test_cover_refuses_a_continuous_scenario(capsys, tmp_path):

@@ -522,6 +522,11 @@ def _greedy_tour(D: np.ndarray) -> np.ndarray:
     return nearest_neighbour_paths(D, [0])[0]
 
 
+def _costs_kind(instance) -> str:
+    """How the run reads its costs, for the result's ``costs`` field (docs/formats.md)."""
+    return "implicit (eq. 2 on demand)" if instance.implicit else "matrix"
+
+
 def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int | None = None,
               neighbours: int = ILS_NEIGHBOURS) -> tuple[np.ndarray, dict]:
     """Iterated local search (2-opt + Or-opt, local double-bridge kicks), compiled and seeded.
@@ -590,7 +595,8 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
         costs = D[tours, np.roll(tours, -1, axis=1)].sum(axis=1)
         best = tours[int(np.argmin(costs))]
         cost = float(costs.min())
-        return _decode(best, dummy, instance), {"engine": "enumeration", "initial_cost": cost, "kicks": 0,
+        return _decode(best, dummy, instance), {"engine": "enumeration", "costs": _costs_kind(instance),
+                                                "initial_cost": cost, "kicks": 0,
                                                 "improving_kicks": 0, "timed_out": False, "tour_cost": cost}
     if instance.implicit:
         nbr = _implicit_neighbour_lists(cm, dummy, neighbours)
@@ -598,7 +604,7 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     else:
         nbr = _neighbour_lists(cm, neighbours)
         tour = _greedy_tour(cm).astype(np.int64)
-    info = {"engine": "numba", "costs": "implicit (eq. 2 on demand)" if instance.implicit else "matrix",
+    info = {"engine": "numba", "costs": _costs_kind(instance),
             "initial_cost": float(_tour_cost(cm, tour))}
     eps = 1e-9 * max(1.0, top)
     done = kept = 0
