@@ -56,8 +56,13 @@ def test_arrows_switches_and_markers_match_the_plan(case_16x7, tmp_path):
     assert by_gid(ax, "start")[0].get_offsets().tolist() == [[plan.start.x, plan.start.y]]
     assert by_gid(ax, "goal")[0].get_offsets().tolist() == [[plan.goal.x, plan.goal.y]]
     assert len([a for a in ax.patches if a.get_gid() == "borrowed rows"]) == plan.stripes_detail[-1]["borrowed"]
+    # each stripe's region cuts, dashed across its band at the cell edge before the cut column (the
+    # default variant picks one of two cut grids per stripe, so the columns differ between stripes)
     cuts = by_gid(ax, "region cuts")[0].get_segments()
-    assert sorted({float(s[0][0]) for s in cuts}) == [3.5, 7.5, 11.5]
+    drawn = sorted((float(seg[0][0]), float(seg[0][1]), float(seg[1][1])) for seg in cuts)
+    expected = sorted((c - 0.5, s["band"][0] - 0.5, s["band"][1] - 0.5) for s in plan.stripes_detail for c in s["cuts"])
+    assert drawn == expected and drawn
+    assert all(0 < c < ws.occupancy.shape[1] for s in plan.stripes_detail for c in s["cuts"])
     path = save_figure(fig, tmp_path / "cover.png")
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     plt.close(fig)
