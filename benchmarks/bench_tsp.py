@@ -8,17 +8,13 @@
 3. Scale: the 64 × 64 ``tiling_64x64`` map (~1000 waypoints): tiling time by both tiling methods,
    then every sequencing method's cost and time side by side (gap to the best), and the default
    (``auto``) tile + sequence time against the one-minute target.
-4. Tiling without tails (issue 16, item 6): ``backtracking``, ``cpsat`` and the ``auto`` portfolio on
-   random maps, each described by its generator and seed below: 400 maps of 10 × 10 (cells or
-   small blocks at 0–20 % density, 15 sets of allowed shapes), 64 × 64 with 5 % of the cells blocked
-   at random or 150 random blocks of up to 3 × 3, 128 × 128 with furniture (2 × 2 and 4 × 4 blocks one
-   cell apart) or 5 % of the cells blocked, and a free 256 × 256. Verdicts must agree.
+4. Tiling without tails (issue 16, item 6) moved to benchmarks/bench_tiling.py.
 5. Backends: the outside solvers ``fast-tsp`` and ``lkh`` (LKH-3 through elkai), where installed,
    beside the project's ``local`` (plain and iterated) and ``ils`` (the compiled iterated local search, its
    kick budget; auto's engine beyond 40 waypoints): on two small TSPLIB instances with their
    published optima (burma14, ulysses16, data inline), TSPLIB-like random uniform instances (integer
-   coordinates in [0, 10⁴), EUC_2D rounding, closed tours; no TSPLIB files are on this machine, so
-   LKH with one run is their reference) and the eq.-2 instance of tiling_64x64 (open path from
+   coordinates in [0, 10⁴), EUC_2D rounding, closed tours; LKH with one run is their reference; the
+   TSPLIB files themselves are part 6) and the eq.-2 instance of tiling_64x64 (open path from
    tile 1). Every cost is re-priced here from the matrix, independently of the solvers.
 
 6. TSPLIB (issue 16): eight classic instances (benchmarks/data/tsplib, 51–1002 cities) against their
@@ -27,7 +23,7 @@
    free maps of 4096–16 384 waypoints tiled and sequenced, time and peak memory (``memory``).
 
 Run:  python benchmarks/bench_tsp.py [--quick] [--seeds N] [--budget S]
-      [--parts agreement,ga,scale,tiling,backends,tsplib,tsplib-ga,obstacles,memory]
+      [--parts agreement,ga,scale,backends,tsplib,tsplib-ga,obstacles,memory]
 """
 
 from __future__ import annotations
@@ -40,7 +36,6 @@ from pathlib import Path
 
 import numpy as np
 
-from htetro_opt.errors import TilingError
 from htetro_opt.problems import SequencingInstance, cost_matrix
 from htetro_opt.scenarios import (
     list_tilesets,
@@ -50,7 +45,10 @@ from htetro_opt.scenarios import (
 )
 from htetro_opt.scenarios.tsplib import load_tsplib, parse_tsplib, tsplib_distances
 from htetro_opt.solvers.sequencing import sequence_waypoints
-from htetro_opt.solvers.tiling import TILING_METHODS, find_tiles, tile_workspace
+from htetro_opt.solvers.tiling import TILING_METHODS, tile_workspace
+
+# the maps' one definition is the tiling benchmark's (this script runs from benchmarks/)
+from bench_tiling import map_furniture  # noqa: E402
 
 WORKSPACES = ("tiling_6x6", "tiling_8x7", "tiling_10x10", "tiling_11x11")
 
@@ -146,116 +144,6 @@ def scale(quick: bool) -> None:
     total = time.perf_counter() - began
     print(f"\nDefault tile + sequence (backtracking + {default.method}): {total:.2f} s "
           f"(target < 60 s), cost {default.cost:.2f}.\n")
-
-
-TEN_SHAPES = (None, "TZ", "T", "IT", "LJT", "SZ", "IO", "ZT", "LT", "IL", "SZT", "TZ", "IT", "LJT", "T")
-
-
-def _area_fixed(occ: np.ndarray) -> np.ndarray:
-    """Block the first free cells (numpy order: bottom row first) until the free area is a multiple of 4."""
-    ys, xs = np.nonzero(~occ)
-    k = int((~occ).sum() % 4)
-    occ[ys[:k], xs[:k]] = True
-    return occ
-
-
-def map_10x10(seed: int):
-    """Seed s: density (0, 5, 10, 15, 20 %)[s % 5]; odd s: random blocks of up to 2 × 2, even s: single
-    cells; shapes TEN_SHAPES[(s // 5) % 15] (tests/solvers/tiling uses the same maps)."""
-    rng = np.random.default_rng(seed)
-    density = (0.0, 0.05, 0.1, 0.15, 0.2)[seed % 5]
-    if seed % 2:
-        occ = np.zeros((10, 10), dtype=bool)
-        for _ in range(int(density * 100 / 2.5)):
-            x, y = rng.integers(0, 10, 2)
-            occ[y:y + rng.integers(1, 3), x:x + rng.integers(1, 3)] = True
-    else:
-        occ = rng.random((10, 10)) < density
-    return _area_fixed(occ), TEN_SHAPES[(seed // 5) % len(TEN_SHAPES)]
-
-
-def map_cells(h: int, w: int, density: float, seed: int) -> np.ndarray:
-    """Each cell blocked with probability ``density`` (default_rng(seed).random((h, w)) < density)."""
-    return _area_fixed(np.random.default_rng(seed).random((h, w)) < density)
-
-
-def map_blocks(h: int, w: int, count: int, seed: int) -> np.ndarray:
-    """``count`` random blocks of 1–3 × 1–3 cells, anywhere (they may touch or overlap)."""
-    rng = np.random.default_rng(seed)
-    occ = np.zeros((h, w), dtype=bool)
-    for _ in range(count):
-        x, y = rng.integers(0, w), rng.integers(0, h)
-        occ[y:y + rng.integers(1, 4), x:x + rng.integers(1, 4)] = True
-    return _area_fixed(occ)
-
-
-def map_furniture(h: int, w: int, count: int, seed: int) -> np.ndarray:
-    """``count`` blocks of 2 × 2 or 4 × 4 cells, each at least one cell from the others and the walls."""
-    rng = np.random.default_rng(seed)
-    occ = np.zeros((h, w), dtype=bool)
-    placed = 0
-    while placed < count:
-        size = int(rng.choice([2, 4]))
-        x, y = int(rng.integers(1, w - size - 1)), int(rng.integers(1, h - size - 1))
-        if not occ[y - 1:y + size + 1, x - 1:x + size + 1].any():
-            occ[y:y + size, x:x + size] = True
-            placed += 1
-    return occ
-
-
-def _tile_once(occ, shapes, method, time_limit):
-    """(verdict, seconds): "yes" (a tiling), "no" (none exists, or a pre-check failed) or "limit"."""
-    began = time.perf_counter()
-    try:
-        find_tiles(occ, shapes=shapes, method=method, time_limit=time_limit)
-        verdict = "yes"
-    except TilingError as err:
-        verdict = "limit" if "time limit" in str(err) else "no"
-    return verdict, time.perf_counter() - began
-
-
-def tiling(quick: bool) -> None:
-    print("## Tiling without tails: backtracking, CP-SAT and the auto portfolio\n")
-    methods = ("backtracking", "cpsat", "auto")
-    limits = {"backtracking": 10.0, "cpsat": 30.0, "auto": 60.0}
-    count = 100 if quick else 400
-    times = {m: [] for m in methods}
-    disagree = 0
-    for seed in range(count):
-        occ, shapes = map_10x10(seed)
-        verdicts = set()
-        for method in methods:
-            verdict, seconds = _tile_once(occ, shapes, method, limits[method] if method != "cpsat" else 10.0)
-            times[method].append(seconds)
-            if verdict != "limit":
-                verdicts.add(verdict)
-        disagree += len(verdicts) > 1
-    print(f"{count} maps of 10 × 10 (map_10x10, seeds 0–{count - 1}); backtracking capped at 10 s, CP-SAT at 10 s:\n")
-    print("| method | max s | maps > 1 s | maps at the cap | total s |")
-    print("|---|---:|---:|---:|---:|")
-    for method in methods:
-        t = times[method]
-        print(f"| {method} | {max(t):.2f} | {sum(x > 1 for x in t)} | {sum(x >= 9.99 for x in t)} | {sum(t):.1f} |")
-    print(f"\nVerdicts disagree on {disagree} maps (a capped run has no verdict).\n")
-    cases = [(f"64 × 64, 5 % cells (map_cells seed {s})", map_cells(64, 64, 0.05, s)) for s in range(2 if quick else 6)]
-    cases += [(f"64 × 64, 150 blocks (map_blocks seed {s})", map_blocks(64, 64, 150, s)) for s in range(2 if quick else 6)]
-    cases += [(f"128 × 128, 60 furniture blocks (map_furniture seed {s})", map_furniture(128, 128, 60, s))
-              for s in range(1 if quick else 3)]
-    cases += [("128 × 128, 5 % cells (map_cells seed 0)", map_cells(128, 128, 0.05, 0)),
-              ("256 × 256 free", np.zeros((256, 256), dtype=bool))]
-    limits = {"backtracking": 30.0, "cpsat": 30.0, "auto": 60.0}
-    print("Larger maps (backtracking and CP-SAT capped at 30 s, auto at 60 s); verdict and seconds:\n")
-    print("| map | free cells | backtracking | cpsat | auto |")
-    print("|---|---:|---|---|---|")
-    for name, occ in cases:
-        cells = []
-        for method in methods:
-            verdict, seconds = _tile_once(occ, None, method, limits[method])
-            cells.append(f"{verdict} {seconds:.2f}")
-        decided = {c.split()[0] for c in cells} - {"limit"}
-        assert len(decided) <= 1, (name, cells)
-        print(f"| {name} | {int((~occ).sum())} | " + " | ".join(cells) + " |", flush=True)
-    print()
 
 
 BURMA14 = """NAME: burma14
@@ -491,14 +379,15 @@ def main() -> None:
     args = parser.parse_args()
     print(f"# Le et al. 2018 benchmark ({platform.python_version()}, {platform.processor() or platform.machine()})\n")
     parts = args.parts.split(",")
+    known = {"agreement", "ga", "scale", "backends", "memory", "tsplib", "tsplib-ga", "obstacles"}
+    if set(parts) - known:  # "tiling" moved to bench_tiling.py: say so rather than run nothing
+        parser.error(f"unknown parts: {', '.join(sorted(set(parts) - known))} (tiling: benchmarks/bench_tiling.py)")
     if "agreement" in parts:
         agreement(args.quick)
     if "ga" in parts:
         ga(args.quick, 2 if args.quick else args.seeds)
     if "scale" in parts:
         scale(args.quick)
-    if "tiling" in parts:
-        tiling(args.quick)
     if "backends" in parts:
         backends(args.quick, args.budget)
     if "memory" in parts:
