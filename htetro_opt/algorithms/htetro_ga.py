@@ -71,7 +71,7 @@ from htetro_opt.operators.commands import (
     GoalReachabilitySurvival,
     RankAndCrowdingTournament,
 )
-from htetro_opt.operators.commands import as_column, sequences
+from htetro_opt.operators.commands import as_column, as_row, sequences
 from htetro_opt.operators.commands.batch import apply_crossover, apply_mutation
 from htetro_opt.operators.commands.duplicates import chromosome_key, first_keys
 from htetro_opt.operators.commands.replan import CommandReachRepair, CommandReplan, replan_rows
@@ -143,12 +143,12 @@ class _Members:
             self.X[i] = self.X[i][: self.executed[i]]
             self._keys[i] = None
             if self.individuals[i] is not None:
-                self.individuals[i].set("X", as_column([self.X[i]])[0])
+                self.individuals[i].set("X", as_row(self.X[i]))
 
     def individual(self, i: int, n_iter: int) -> Individual:
         """Row i's pymoo Individual, made as pymoo's evaluator would have left it."""
         if self.individuals[i] is None:
-            ind = Individual(X=as_column([self.X[i]])[0], F=self.F[i].copy(), n_gen=n_iter, n_iter=n_iter,
+            ind = Individual(X=as_row(self.X[i]), F=self.F[i].copy(), n_gen=n_iter, n_iter=n_iter,
                              **{key: getattr(self, key)[i] for key in _COLUMNS})
             ind.evaluated.update(_EVALUATED)
             self.individuals[i] = ind

@@ -80,6 +80,54 @@ def _compiled_walk():
 _walk_kernel = None
 
 
+def _summary(keys, lengths, goal_keys, stop_at_goal, dead_key, n_columns, progress, first_invalid, executed,
+             final_ids):
+    """The integer outcome of a run, per sequence (column ``b`` of the (L + 1, B) ``keys``), into the
+    arrays given: the roadmap progress (the first step at or after the previous hit where the next
+    pose is met), the first invalid command (-1 if none) before the run's end (the goal's step with
+    ``stop_at_goal``), the commands executed and the final pose id. :meth:`Simulator._summarise`
+    compiled (:func:`_compiled_summary`): as numpy calls on the whole (L + 1, B) array it cost a
+    dozen passes over it."""
+    width = keys.shape[0] - 1
+    n_goals = len(goal_keys)
+    for b in range(keys.shape[1]):
+        k, when = 0, 0
+        while k < n_goals:
+            t = when
+            while t <= width and keys[t, b] != goal_keys[k]:
+                t += 1
+            if t > width:
+                break
+            k, when = k + 1, t
+        progress[b] = k + 1
+        run_length = lengths[b]
+        if stop_at_goal and n_goals and k == n_goals:
+            run_length = min(run_length, when)
+        first_invalid[b] = -1
+        for t in range(1, min(run_length, width) + 1):
+            if keys[t, b] == dead_key:
+                first_invalid[b] = t - 1
+                break
+        executed[b] = first_invalid[b] if first_invalid[b] >= 0 else run_length
+        final_ids[b] = keys[executed[b], b] // n_columns
+
+
+_summary_kernel = None
+
+
+def _compiled_summary():
+    """:func:`_summary` compiled by numba on its first use, as :func:`_compiled_walk`."""
+    global _summary_kernel
+    if _summary_kernel is None:
+        try:
+            import numba
+        except ImportError:  # pragma: no cover - numba is a core dependency
+            _summary_kernel = _summary
+        else:
+            _summary_kernel = numba.njit(cache=True, nogil=True)(_summary)
+    return _summary_kernel
+
+
 def _blocked_at(blocked, lo, hi, key):
     """Whether ``key`` is among the sorted ``blocked[lo:hi]``."""
     i = lo + np.searchsorted(blocked[lo:hi], key)
@@ -581,7 +629,9 @@ class Simulator:
                 raise ParameterError(
                     "sequences must be a batch of command-id sequences (e.g. [parse_commands('x+,y+')]), "
                     f"got {type(sequences).__name__} {reprlib.repr(sequences)}")
-            arrays = [_command_ids(s, i) for i, s in enumerate(sequences)]
+            arrays = sequences if type(sequences) is list and all(
+                type(s) is np.ndarray and s.dtype == np.int64 and s.ndim == 1 for s in sequences
+            ) else [_command_ids(s, i) for i, s in enumerate(sequences)]  # the GAs' batches pass as they are
             lengths = np.fromiter((len(a) for a in arrays), dtype=np.int64, count=len(arrays))
             width = int(lengths.max()) if len(lengths) else 0
             present = np.arange(width)[None, :] < lengths[:, None]
@@ -727,28 +777,11 @@ class Simulator:
     def _summarise(self, keys, local, lengths, goal_keys, stop_at_goal) -> SimulationResult:
         """Per-sequence outcome from the (L + 1, B) keys of a run."""
         width, batch = keys.shape[0] - 1, keys.shape[1]
-        steps = np.arange(width + 1)[:, None]
-        # Roadmap progress: the first step at or after the previous hit where the next pose is met.
-        progress = np.ones(batch, dtype=np.int64)
-        when = np.zeros(batch, dtype=np.int64)
-        for k, goal in enumerate(goal_keys, start=1):
-            hit = (keys == goal) & (steps >= when) & (progress == k)
-            found = hit.any(axis=0)
-            progress[found] += 1
-            when[found] = hit.argmax(axis=0)[found]
-        run_length = lengths
+        progress, first_invalid, executed, final_ids = (np.empty(batch, dtype=np.int64) for _ in range(4))
+        _compiled_summary()(keys, np.asarray(lengths, dtype=np.int64), np.asarray(goal_keys, dtype=np.int64),
+                            bool(stop_at_goal), self.dead * self.n_columns, self.n_columns, progress, first_invalid,
+                            executed, final_ids)
         done = progress == len(goal_keys) + 1
-        if stop_at_goal and len(goal_keys):
-            run_length = np.where(done, np.minimum(lengths, when), lengths)
-        died = keys[1:] == self.dead * self.n_columns
-        if not (run_length == width).all():
-            died &= steps[1:] <= run_length
-        first_invalid = np.full(batch, -1, dtype=np.int64)
-        if width:
-            any_died = died.any(axis=0)
-            first_invalid[any_died] = died.argmax(axis=0)[any_died]
-        executed = np.where(first_invalid >= 0, first_invalid, run_length)
-        final_ids = keys[executed, np.arange(batch)] // self.n_columns
         reached = done & (final_ids * self.n_columns == goal_keys[-1]) if len(goal_keys) else np.zeros(batch, dtype=bool)
         durations = self.durations[local]
         durations[np.arange(width)[None, :] >= executed[:, None]] = 0.0

@@ -44,6 +44,44 @@ __all__ = [
     "safety_field",
 ]
 
+
+def _smoothness_safety(keys, local, executed, n_columns, pose_danger, changes, total):
+    """Per sequence (column ``b`` of the (L + 1, B) ``keys``): the command changes among its first
+    ``executed`` commands, and the danger of the poses after its commands summed in command order
+    (those past ``executed`` adding 0.0, as the cumulative sum over the padded batch did, so the
+    float sum is that sum bit for bit). :meth:`CommandPathProblem.fitness`'s loops, compiled
+    (:func:`_compiled_smoothness_safety`): as numpy calls they made several (L, B) temporaries."""
+    width = local.shape[1]
+    for b in range(local.shape[0]):
+        done = executed[b]
+        count = 0
+        for t in range(1, min(done, width)):
+            if local[b, t] != local[b, t - 1]:
+                count += 1
+        changes[b] = count
+        acc = 0.0
+        for t in range(width):
+            value = pose_danger[keys[t + 1, b] // n_columns] if t < done else 0.0
+            acc = value if t == 0 else acc + value
+        total[b] = acc
+
+
+_smoothness_safety_kernel = None
+
+
+def _compiled_smoothness_safety():
+    """:func:`_smoothness_safety` compiled by numba on its first use (importing this module does not
+    import numba: see :func:`htetro_opt.model.simulate._compiled_walk`); without numba it runs as Python."""
+    global _smoothness_safety_kernel
+    if _smoothness_safety_kernel is None:
+        try:
+            import numba
+        except ImportError:  # pragma: no cover - numba is a core dependency
+            _smoothness_safety_kernel = _smoothness_safety
+        else:
+            _smoothness_safety_kernel = numba.njit(cache=True, nogil=True)(_smoothness_safety)
+    return _smoothness_safety_kernel
+
 FITNESS_NAMES = ("f_gr", "f_t", "f_sm", "f_sf")
 """The four fitnesses f_gr, f_t, f_sm, f_sf in objective order."""
 
@@ -224,19 +262,13 @@ class CommandPathProblem(Problem):
         sim = self.simulator
         batch = len(result)
         executed = result.executed
-        columns = np.arange(result.local.shape[1])
-        poses = result.keys // sim.n_columns  # (L + 1, B)
-        final = poses[executed, np.arange(batch)]
+        final = result.keys[executed, np.arange(batch)] // sim.n_columns
         f_gr = self._pose_reachability[final]
         f_t = 1.0 - result.time / self.t_max
-        local = result.local
-        changes = ((local[:, 1:] != local[:, :-1]) & (columns[None, 1:] < executed[:, None])).sum(axis=1)
+        changes, total = np.empty(batch, dtype=np.int64), np.zeros(batch)
+        _compiled_smoothness_safety()(result.keys, result.local, np.asarray(executed, dtype=np.int64), sim.n_columns,
+                                      self._pose_danger, changes, total)
         f_sm = np.where(executed > 1, 1.0 - changes / np.maximum(executed - 1, 1), 1.0)
-        danger = self._pose_danger[poses[1:]]  # (L, B): pose after command i
-        danger[columns[:, None] >= executed[None, :]] = 0.0
-        # Summed in command order (cumsum): numpy's sum would add a batch of one pairwise, so a
-        # sequence's f_sf would depend, in its last bit, on the batch it is evaluated in.
-        total = danger.cumsum(axis=0)[-1] if len(danger) else np.zeros(batch)
         f_sf = np.where(executed > 0, 1.0 - total / (np.maximum(executed, 1) * SAFETY_COEFFICIENT), 1.0)
         return np.column_stack([f_gr, f_t, f_sm, f_sf])
 

@@ -18,7 +18,7 @@ takes the ``random_state`` pymoo passes:
 - :mod:`.survival`: the goal-reachability sort (:class:`GoalReachabilitySurvival`).
 """
 
-from htetro_opt.operators.commands._chromosome import as_column, displacement, sequences
+from htetro_opt.operators.commands._chromosome import as_column, as_row, displacement, sequences
 from htetro_opt.operators.commands.crossover import CommandCrossover, single_point_crossover
 from htetro_opt.operators.commands.duplicates import CommandDuplicateElimination, chromosome_key
 from htetro_opt.operators.commands.mutation import CommandMutation, mutate_commands
@@ -45,7 +45,7 @@ from htetro_opt.operators.commands.selection import RankAndCrowdingTournament, r
 from htetro_opt.operators.commands.survival import GoalReachabilitySurvival, reaches_goal
 
 __all__ = [
-    "as_column", "displacement", "sequences",
+    "as_column", "as_row", "displacement", "sequences",
     "CommandCrossover", "single_point_crossover",
     "CommandDuplicateElimination", "chromosome_key",
     "CommandMutation", "mutate_commands",

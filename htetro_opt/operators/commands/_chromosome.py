@@ -9,7 +9,7 @@ import numpy as np
 
 from htetro_opt.model.commands import COMMANDS
 
-__all__ = ["SHIFTS", "MOVES", "as_column", "sequences", "displacement", "Flat"]
+__all__ = ["SHIFTS", "MOVES", "as_row", "as_column", "sequences", "displacement", "Flat"]
 
 SHIFTS = np.array([c.shift for c in COMMANDS], dtype=np.int64)
 """(dx, dy) of B2 for every global command id."""
@@ -18,12 +18,33 @@ MOVES = (SHIFTS != 0).any(axis=1)
 """Commands that move B2 (translations and diagonals); every other command leaves it in place."""
 
 
+def _as_genes(s) -> np.ndarray:
+    return s if type(s) is np.ndarray and s.dtype == np.int64 and s.ndim == 1 else np.asarray(s, dtype=np.int64).ravel()
+
+
+def as_row(s) -> np.ndarray:
+    """One chromosome as a row of :func:`as_column`: shape (1,), object dtype, holding an int64 array.
+
+    The hTetro-GA stores rows in pymoo ``Individual`` objects one at a time, several times a
+    generation: this spares it building a one-row design matrix for each.
+
+    Examples
+    --------
+    >>> row = as_row([3, 1])
+    >>> row.shape, row[0].tolist(), bool((row[0] == as_column([[3, 1]])[0][0]).all())
+    ((1,), [3, 1], True)
+    """
+    row = np.empty(1, dtype=object)
+    row[0] = _as_genes(s)
+    return row
+
+
 def as_column(seqs: Iterable[np.ndarray]) -> np.ndarray:
     """Chromosomes as pymoo's design matrix: shape (n, 1), object dtype, one int64 array per row."""
     seqs = list(seqs)
     X = np.empty((len(seqs), 1), dtype=object)
     for i, s in enumerate(seqs):
-        X[i, 0] = s if type(s) is np.ndarray and s.dtype == np.int64 and s.ndim == 1 else np.asarray(s, dtype=np.int64).ravel()
+        X[i, 0] = s if type(s) is np.ndarray and s.dtype == np.int64 and s.ndim == 1 else _as_genes(s)  # the GAs' case inline
     return X
 
 

@@ -48,12 +48,8 @@ def first_keys(keys, seen: set | None = None) -> np.ndarray:
     [0, 1]
     """
     seen = set() if seen is None else seen
-    keep = []
-    for i, key in enumerate(keys):
-        if key not in seen:
-            seen.add(key)
-            keep.append(i)
-    return np.array(keep, dtype=np.int64)
+    add = seen.add  # returns None: the comprehension keeps a new key and records it in one test
+    return np.array([i for i, key in enumerate(keys) if not (key in seen or add(key))], dtype=np.int64)
 
 
 class CommandDuplicateElimination(DuplicateElimination):

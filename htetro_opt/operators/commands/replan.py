@@ -84,6 +84,7 @@ class TransitionGraph:
         self.period = sim.workspace.period if sim.workspace.moving else 1
         self._static: tuple[csr_matrix, np.ndarray] | None = None
         self._reverse: csr_matrix | None = None
+        self._edges: np.ndarray | None = None  # the static graph's edges as sorted keys, for :meth:`_path`
         self._labels: np.ndarray | None = None  # the timed search's best time per (phase, pose), reset after use
         self._answers: dict[tuple, list] = {}
         self._graph()
@@ -252,12 +253,14 @@ class TransitionGraph:
         nodes = [end]
         while nodes[-1] != start:
             nodes.append(int(pred[nodes[-1]]))
-        nodes.reverse()
-        columns = []
-        for a, b in zip(nodes[:-1], nodes[1:]):
-            lo, hi = matrix.indptr[a], matrix.indptr[a + 1]
-            columns.append(commands[lo + np.searchsorted(matrix.indices[lo:hi], b)])
-        return self.simulator.command_ids[np.array(columns, dtype=np.int64)]
+        nodes = np.array(nodes[::-1], dtype=np.int64)
+        if self._edges is None:
+            # Each edge as (pose * n + next pose): sorted, as CSR rows are in order and each row's
+            # columns sorted, so the edges of a whole path are one searchsorted.
+            rows = np.repeat(np.arange(self.n_poses, dtype=np.int64), np.diff(matrix.indptr))
+            self._edges = rows * self.n_poses + matrix.indices
+        edges = np.searchsorted(self._edges, nodes[:-1] * self.n_poses + nodes[1:])
+        return self.simulator.command_ids[commands[edges].astype(np.int64)]
 
 
 def replan_windows(problem, seqs: list[np.ndarray], *, window: int, random_state: np.random.Generator,

@@ -36,9 +36,79 @@ def cut_longest_loop(trace: np.ndarray, executed: int) -> tuple[int, int] | None
     return int(first[k]), int(last[k])
 
 
+def _longest_loops(trace, executed, first_seen, cut_i, cut_j):
+    """The loop of :func:`longest_loops`, row by row: ``first_seen`` (all -1, left so) holds each
+    pose's first step in the row being read, indexed by pose id less the smallest."""
+    for b in range(trace.shape[0]):
+        end = min(executed[b], trace.shape[1] - 1)
+        best_span, best_first = 0, 0
+        for t in range(end + 1):
+            p = trace[b, t]
+            if first_seen[p] < 0:
+                first_seen[p] = t
+            span = t - first_seen[p]
+            # The pose's last step gives its span; of equal spans, the earliest first step.
+            if span > best_span or (span == best_span and span > 0 and first_seen[p] < best_first):
+                best_span, best_first = span, first_seen[p]
+        for t in range(end + 1):
+            first_seen[trace[b, t]] = -1
+        if best_span > 0:
+            cut_i[b], cut_j[b] = best_first, best_first + best_span
+
+
+_longest_loops_kernel = None
+
+
+def _compiled_longest_loops():
+    """:func:`_longest_loops` compiled by numba on its first use (importing this module does not import
+    numba: see :func:`htetro_opt.model.simulate._compiled_walk`); without numba it runs as Python."""
+    global _longest_loops_kernel
+    if _longest_loops_kernel is None:
+        try:
+            import numba
+        except ImportError:  # pragma: no cover - numba is a core dependency
+            _longest_loops_kernel = _longest_loops
+        else:
+            _longest_loops_kernel = numba.njit(cache=True, nogil=True)(_longest_loops)
+    return _longest_loops_kernel
+
+
+def _cut_rows(local, keys, rows, cut_i, cut_j, pad, out_local, out_keys):
+    """The rows of :func:`cut_result` with their loops cut, into ``out_local`` (B, L) and ``out_keys``
+    (L + 1, B) (copies of ``local`` and ``keys``): command t of a cut row is command t + shift before
+    from the cut on (``pad`` past the end), pose t is pose t + shift before after the cut (the last
+    pose past the end)."""
+    width = local.shape[1]
+    for r in rows:
+        start, shift = cut_i[r], cut_j[r] - cut_i[r]
+        for t in range(start, width):
+            out_local[r, t] = local[r, t + shift] if t + shift < width else pad
+        for t in range(start + 1, width + 1):
+            out_keys[t, r] = keys[min(t + shift, width), r]
+
+
+_cut_rows_kernel = None
+
+
+def _compiled_cut_rows():
+    """:func:`_cut_rows` compiled by numba on its first use, as :func:`_compiled_longest_loops`."""
+    global _cut_rows_kernel
+    if _cut_rows_kernel is None:
+        try:
+            import numba
+        except ImportError:  # pragma: no cover - numba is a core dependency
+            _cut_rows_kernel = _cut_rows
+        else:
+            _cut_rows_kernel = numba.njit(cache=True, nogil=True)(_cut_rows)
+    return _cut_rows_kernel
+
+
 def longest_loops(trace: np.ndarray, executed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`cut_longest_loop` for a batch: ``trace`` (B, L + 1), ``executed`` (B,); returns the
     cut ``(i, j)`` of each row, ``i == j`` where a row has no loop.
+
+    One pass over each row's executed poses, compiled (a generation's shortcut calls it on every
+    conservative offspring); its scratch array spans the poses' ids, from the smallest to the largest.
 
     Examples
     --------
@@ -46,31 +116,17 @@ def longest_loops(trace: np.ndarray, executed: np.ndarray) -> tuple[np.ndarray, 
     (array([0, 0]), array([4, 0]))
     """
     trace = np.asarray(trace)
+    executed = np.asarray(executed).astype(np.int64)
     batch, width = trace.shape
     cut_i, cut_j = np.zeros(batch, dtype=np.int64), np.zeros(batch, dtype=np.int64)
-    inside = np.arange(width)[None, :] <= np.asarray(executed)[:, None]
+    inside = np.arange(width)[None, :] <= executed[:, None]
     if not inside.any():
         return cut_i, cut_j
-    rows = np.broadcast_to(np.arange(batch, dtype=np.int64)[:, None], trace.shape)[inside]
-    steps = np.broadcast_to(np.arange(width, dtype=np.int64), trace.shape)[inside]
-    poses = trace[inside].astype(np.int64)
-    n_poses = int(poses.max()) + 1
-    # One sort of distinct keys (row, pose, step): each (row, pose) group's first and last step are
-    # its ends, and no sort needs to be stable.
-    key = np.sort((rows * n_poses + poses) * width + steps)
-    group = key // width
-    starts = np.flatnonzero(np.r_[True, group[1:] != group[:-1]])
-    first = key[starts] % width
-    last = key[np.r_[starts[1:], len(key)] - 1] % width
-    row = group[starts] // n_poses
-    # Per row, the longest span and the earliest of equals: the largest span * width + (width − 1 − first).
-    score = (last - first) * width + (width - 1 - first)
-    row_starts = np.flatnonzero(np.r_[True, row[1:] != row[:-1]])
-    best = np.maximum.reduceat(score, row_starts)
-    span, first = best // width, width - 1 - best % width
-    has = span > 0
-    looped = row[row_starts][has]
-    cut_i[looped], cut_j[looped] = first[has], first[has] + span[has]
+    # Poses past a row's executed part are never read, but may be any value: set to the smallest read.
+    lowest = int(trace[inside].min())
+    poses = np.where(inside, trace, lowest).astype(np.int64) - lowest
+    first_seen = np.full(int(poses.max()) + 1, -1, dtype=np.int64)
+    _compiled_longest_loops()(poses, executed, first_seen, cut_i, cut_j)
     return cut_i, cut_j
 
 
@@ -122,15 +178,11 @@ def cut_result(result, cut_i: np.ndarray, cut_j: np.ndarray) -> SimulationResult
         return result
     sim = result.simulator
     width = result.local.shape[1]
-    start, shift = cut_i[rows][:, None], (cut_j - cut_i)[rows][:, None]
+    shift = (cut_j - cut_i)[rows][:, None]
     steps = np.arange(width)[None, :]
-    source = steps + np.where(steps >= start, shift, 0)  # command t of a cut row is command source[t] before
-    local = result.local.copy()
-    local[rows] = np.where(source < width, np.take_along_axis(local[rows], source.clip(max=width - 1), axis=1), sim.pad)
-    poses = np.arange(width + 1)[None, :]
-    source = poses + np.where(poses > start, shift, 0)  # pose t after the cut is pose source[t] before
-    keys = result.keys.copy()
-    keys[:, rows] = np.take_along_axis(keys[:, rows], source.clip(max=width).T, axis=0)
+    local, keys = result.local.copy(), result.keys.copy()
+    _compiled_cut_rows()(result.local, result.keys, rows, np.asarray(cut_i, dtype=np.int64),
+                         np.asarray(cut_j, dtype=np.int64), sim.pad, local, keys)
     executed = result.executed.copy()
     executed[rows] -= shift[:, 0]
     first_invalid = result.first_invalid.copy()
