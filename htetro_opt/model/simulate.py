@@ -28,6 +28,7 @@ from functools import cached_property
 
 import numpy as np
 
+from htetro_opt._jit import lazy_jit
 from htetro_opt._validation import check_bool, check_int
 from htetro_opt.errors import ConfigurationError, ParameterError, PlanningError, UnknownCommandError
 from htetro_opt.model.commands import (
@@ -56,37 +57,14 @@ A map that would need more is refused before anything is allocated, with what wo
 _ROWS_PER_SORT = 1 << 16
 """Poses whose valid commands the repair sorts at a time (bounds the sort's temporary arrays)."""
 
-def _compiled_walk():
-    """:func:`_walk` compiled by numba, on its first use.
-
-    Compiled here rather than at import so that importing the model (the tiler, the scenario
-    loader, the CLI's start) does not pay numba's import, about half a second; numba's on-disk cache
-    makes later processes load the compiled loop instead of compiling it. Without numba the loop
-    runs as Python, with the same results.
-    """
-    global _blocked_at, _walk_kernel
-    if _walk_kernel is None:
-        try:
-            import numba
-        except ImportError:  # pragma: no cover - numba is a core dependency
-            _walk_kernel = _walk
-        else:
-            jit = numba.njit(cache=True, nogil=True)
-            _blocked_at = jit(_blocked_at)  # _walk calls it by this global name, so it must be compiled first
-            _walk_kernel = jit(_walk)
-    return _walk_kernel
-
-
-_walk_kernel = None
-
-
+@lazy_jit
 def _summary(keys, lengths, goal_keys, stop_at_goal, dead_key, n_columns, progress, first_invalid, executed,
              final_ids):
     """The integer outcome of a run, per sequence (column ``b`` of the (L + 1, B) ``keys``), into the
     arrays given: the roadmap progress (the first step at or after the previous hit where the next
     pose is met), the first invalid command (-1 if none) before the run's end (the goal's step with
     ``stop_at_goal``), the commands executed and the final pose id. :meth:`Simulator._summarise`
-    compiled (:func:`_compiled_summary`): as numpy calls on the whole (L + 1, B) array it cost a
+    compiled (:func:`htetro_opt._jit.lazy_jit`): as numpy calls on the whole (L + 1, B) array it cost a
     dozen passes over it."""
     width = keys.shape[0] - 1
     n_goals = len(goal_keys)
@@ -112,28 +90,13 @@ def _summary(keys, lengths, goal_keys, stop_at_goal, dead_key, n_columns, progre
         final_ids[b] = keys[executed[b], b] // n_columns
 
 
-_summary_kernel = None
-
-
-def _compiled_summary():
-    """:func:`_summary` compiled by numba on its first use, as :func:`_compiled_walk`."""
-    global _summary_kernel
-    if _summary_kernel is None:
-        try:
-            import numba
-        except ImportError:  # pragma: no cover - numba is a core dependency
-            _summary_kernel = _summary
-        else:
-            _summary_kernel = numba.njit(cache=True, nogil=True)(_summary)
-    return _summary_kernel
-
-
 def _blocked_at(blocked, lo, hi, key):
     """Whether ``key`` is among the sorted ``blocked[lo:hi]``."""
     i = lo + np.searchsorted(blocked[lo:hi], key)
     return i < hi and blocked[i] == key
 
 
+@lazy_jit(calls=("_blocked_at",))  # compiled on first use: importing the model does not import numba
 def _walk(keys, steps, lengths, flat, table, n_commands, dead_key, blocked, offsets, t0, repair, u, used, t):
     """The hot loop of :meth:`Simulator._step_all`, compiled: steps ``t``, ``t + 1``, … of the batch;
     returns the next step to run (``len(steps)`` when done) and the draws of ``u`` used.
@@ -740,7 +703,7 @@ class Simulator:
                 state = repair.bit_generator.state
                 u = repair.random(max(4096, 4 * batch * per_row))
                 repair.bit_generator.state = state
-            t, used = _compiled_walk()(keys, steps, lengths, flat, table, self.n_commands, dead_key, blocked, offsets,
+            t, used = _walk(keys, steps, lengths, flat, table, self.n_commands, dead_key, blocked, offsets,
                             t0, repair is not None, u, 0, t)
             if used:
                 repair.random(used)  # the generator moves on by the draws the steps took
@@ -778,7 +741,7 @@ class Simulator:
         """Per-sequence outcome from the (L + 1, B) keys of a run."""
         width, batch = keys.shape[0] - 1, keys.shape[1]
         progress, first_invalid, executed, final_ids = (np.empty(batch, dtype=np.int64) for _ in range(4))
-        _compiled_summary()(keys, np.asarray(lengths, dtype=np.int64), np.asarray(goal_keys, dtype=np.int64),
+        _summary(keys, np.asarray(lengths, dtype=np.int64), np.asarray(goal_keys, dtype=np.int64),
                             bool(stop_at_goal), self.dead * self.n_columns, self.n_columns, progress, first_invalid,
                             executed, final_ids)
         done = progress == len(goal_keys) + 1

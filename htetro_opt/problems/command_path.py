@@ -29,6 +29,7 @@ from typing import Sequence
 import numpy as np
 from pymoo.core.problem import Problem
 
+from htetro_opt._jit import lazy_jit
 from htetro_opt._validation import check_int
 from htetro_opt.errors import ParameterError, ScenarioError
 from htetro_opt.model.commands import SEED000_COMMANDS, Timing
@@ -45,12 +46,13 @@ __all__ = [
 ]
 
 
+@lazy_jit  # compiled on first use: importing the problem does not import numba
 def _smoothness_safety(keys, local, executed, n_columns, pose_danger, changes, total):
     """Per sequence (column ``b`` of the (L + 1, B) ``keys``): the command changes among its first
     ``executed`` commands, and the danger of the poses after its commands summed in command order
     (those past ``executed`` adding 0.0, as the cumulative sum over the padded batch did, so the
     float sum is that sum bit for bit). :meth:`CommandPathProblem.fitness`'s loops, compiled
-    (:func:`_compiled_smoothness_safety`): as numpy calls they made several (L, B) temporaries."""
+    (:func:`htetro_opt._jit.lazy_jit`): as numpy calls they made several (L, B) temporaries."""
     width = local.shape[1]
     for b in range(local.shape[0]):
         done = executed[b]
@@ -65,22 +67,6 @@ def _smoothness_safety(keys, local, executed, n_columns, pose_danger, changes, t
             acc = value if t == 0 else acc + value
         total[b] = acc
 
-
-_smoothness_safety_kernel = None
-
-
-def _compiled_smoothness_safety():
-    """:func:`_smoothness_safety` compiled by numba on its first use (importing this module does not
-    import numba: see :func:`htetro_opt.model.simulate._compiled_walk`); without numba it runs as Python."""
-    global _smoothness_safety_kernel
-    if _smoothness_safety_kernel is None:
-        try:
-            import numba
-        except ImportError:  # pragma: no cover - numba is a core dependency
-            _smoothness_safety_kernel = _smoothness_safety
-        else:
-            _smoothness_safety_kernel = numba.njit(cache=True, nogil=True)(_smoothness_safety)
-    return _smoothness_safety_kernel
 
 FITNESS_NAMES = ("f_gr", "f_t", "f_sm", "f_sf")
 """The four fitnesses f_gr, f_t, f_sm, f_sf in objective order."""
@@ -266,7 +252,7 @@ class CommandPathProblem(Problem):
         f_gr = self._pose_reachability[final]
         f_t = 1.0 - result.time / self.t_max
         changes, total = np.empty(batch, dtype=np.int64), np.zeros(batch)
-        _compiled_smoothness_safety()(result.keys, result.local, np.asarray(executed, dtype=np.int64), sim.n_columns,
+        _smoothness_safety(result.keys, result.local, np.asarray(executed, dtype=np.int64), sim.n_columns,
                                       self._pose_danger, changes, total)
         f_sm = np.where(executed > 1, 1.0 - changes / np.maximum(executed - 1, 1), 1.0)
         f_sf = np.where(executed > 0, 1.0 - total / (np.maximum(executed, 1) * SAFETY_COEFFICIENT), 1.0)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pymoo.core.mutation import Mutation
 
+from htetro_opt._jit import lazy_jit
 from htetro_opt.model.simulate import SimulationResult
 from htetro_opt.operators.commands._chromosome import as_column, sequences
 
@@ -36,6 +37,7 @@ def cut_longest_loop(trace: np.ndarray, executed: int) -> tuple[int, int] | None
     return int(first[k]), int(last[k])
 
 
+@lazy_jit  # compiled on first use: importing the operators does not import numba
 def _longest_loops(trace, executed, first_seen, cut_i, cut_j):
     """The loop of :func:`longest_loops`, row by row: ``first_seen`` (all -1, left so) holds each
     pose's first step in the row being read, indexed by pose id less the smallest."""
@@ -56,23 +58,7 @@ def _longest_loops(trace, executed, first_seen, cut_i, cut_j):
             cut_i[b], cut_j[b] = best_first, best_first + best_span
 
 
-_longest_loops_kernel = None
-
-
-def _compiled_longest_loops():
-    """:func:`_longest_loops` compiled by numba on its first use (importing this module does not import
-    numba: see :func:`htetro_opt.model.simulate._compiled_walk`); without numba it runs as Python."""
-    global _longest_loops_kernel
-    if _longest_loops_kernel is None:
-        try:
-            import numba
-        except ImportError:  # pragma: no cover - numba is a core dependency
-            _longest_loops_kernel = _longest_loops
-        else:
-            _longest_loops_kernel = numba.njit(cache=True, nogil=True)(_longest_loops)
-    return _longest_loops_kernel
-
-
+@lazy_jit
 def _cut_rows(local, keys, rows, cut_i, cut_j, pad, out_local, out_keys):
     """The rows of :func:`cut_result` with their loops cut, into ``out_local`` (B, L) and ``out_keys``
     (L + 1, B) (copies of ``local`` and ``keys``): command t of a cut row is command t + shift before
@@ -85,22 +71,6 @@ def _cut_rows(local, keys, rows, cut_i, cut_j, pad, out_local, out_keys):
             out_local[r, t] = local[r, t + shift] if t + shift < width else pad
         for t in range(start + 1, width + 1):
             out_keys[t, r] = keys[min(t + shift, width), r]
-
-
-_cut_rows_kernel = None
-
-
-def _compiled_cut_rows():
-    """:func:`_cut_rows` compiled by numba on its first use, as :func:`_compiled_longest_loops`."""
-    global _cut_rows_kernel
-    if _cut_rows_kernel is None:
-        try:
-            import numba
-        except ImportError:  # pragma: no cover - numba is a core dependency
-            _cut_rows_kernel = _cut_rows
-        else:
-            _cut_rows_kernel = numba.njit(cache=True, nogil=True)(_cut_rows)
-    return _cut_rows_kernel
 
 
 def longest_loops(trace: np.ndarray, executed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -126,7 +96,7 @@ def longest_loops(trace: np.ndarray, executed: np.ndarray) -> tuple[np.ndarray, 
     lowest = int(trace[inside].min())
     poses = np.where(inside, trace, lowest).astype(np.int64) - lowest
     first_seen = np.full(int(poses.max()) + 1, -1, dtype=np.int64)
-    _compiled_longest_loops()(poses, executed, first_seen, cut_i, cut_j)
+    _longest_loops(poses, executed, first_seen, cut_i, cut_j)
     return cut_i, cut_j
 
 
@@ -181,7 +151,7 @@ def cut_result(result, cut_i: np.ndarray, cut_j: np.ndarray) -> SimulationResult
     shift = (cut_j - cut_i)[rows][:, None]
     steps = np.arange(width)[None, :]
     local, keys = result.local.copy(), result.keys.copy()
-    _compiled_cut_rows()(result.local, result.keys, rows, np.asarray(cut_i, dtype=np.int64),
+    _cut_rows(result.local, result.keys, rows, np.asarray(cut_i, dtype=np.int64),
                          np.asarray(cut_j, dtype=np.int64), sim.pad, local, keys)
     executed = result.executed.copy()
     executed[rows] -= shift[:, 0]

@@ -1,0 +1,59 @@
+"""Compiling a hot loop with numba on its first call, so that importing a module never imports numba.
+
+numba is a core dependency, but importing it costs about half a second: the model, the problems
+and the operators are imported by every command of the CLI and by the tiler, which mostly never run
+these loops. A loop wrapped by :func:`lazy_jit` is compiled (``cache=True``: later processes load it
+from numba's on-disk cache) the first time it is called; without numba it runs as Python, with the
+same results.
+"""
+
+from __future__ import annotations
+
+import functools
+
+__all__ = ["lazy_jit"]
+
+
+def _njit(function):
+    try:
+        import numba
+    except ImportError:  # pragma: no cover - numba is a core dependency
+        return function
+    return numba.njit(cache=True, nogil=True)(function)
+
+
+def lazy_jit(function=None, *, calls: tuple[str, ...] = ()):
+    """``function`` compiled by numba on its first call.
+
+    Parameters
+    ----------
+    function : callable
+        A function defined at module level in a file (numba's cache needs the file) that numba can
+        compile in nopython mode.
+    calls : tuple of str
+        Names of other module-level functions that ``function`` calls: numba resolves them from
+        the module's globals when it compiles, so they are compiled first and rebound there.
+
+    Examples
+    --------
+    The simulator's step loop is wrapped at import and compiled when a simulation first runs:
+
+    >>> from htetro_opt.model import simulate
+    >>> simulate._walk.py_func.__name__
+    '_walk'
+    """
+    if function is None:
+        return functools.partial(lazy_jit, calls=calls)
+    compiled = None
+
+    @functools.wraps(function)
+    def call(*args):
+        nonlocal compiled
+        if compiled is None:
+            for name in calls:
+                function.__globals__[name] = _njit(function.__globals__[name])
+            compiled = _njit(function)
+        return compiled(*args)
+
+    call.py_func = function  # the Python version, for tests that compare the two
+    return call
