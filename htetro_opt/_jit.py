@@ -36,11 +36,14 @@ def lazy_jit(function=None, *, calls: tuple[str, ...] = ()):
 
     Examples
     --------
-    The simulator's step loop is wrapped at import and compiled when a simulation first runs:
+    The shortcut's loop search is wrapped at import and compiled when it first runs:
 
-    >>> from htetro_opt.model import simulate
-    >>> simulate._walk.py_func.__name__
-    '_walk'
+    >>> import numpy as np
+    >>> from htetro_opt.operators.commands.shortcut import _longest_loops, longest_loops
+    >>> _longest_loops.py_func.__name__
+    '_longest_loops'
+    >>> [v.tolist() for v in longest_loops(np.array([[0, 1, 2, 1, 3]]), np.array([4]))]
+    [[1], [3]]
     """
     if function is None:
         return functools.partial(lazy_jit, calls=calls)
