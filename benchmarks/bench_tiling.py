@@ -11,7 +11,11 @@ A fixed, seeded family of maps, each described by its generator and seed below:
   150, seed)``, seeds 0–5;
 - 128 × 128 with obstacles: ``map_furniture(128, 128, 60, seed)``, ``map_cells(128, 128, 0.05,
   seed)`` and ``map_blocks(128, 128, 400, seed)``, seeds 0–2;
-- the free 256 × 256 grid.
+- the free 256 × 256 grid;
+- 64 × 64 with few shapes: ``map_restricted(64, shapes, blocked, moved, seed)`` for shapes TZ, O, I
+  and T (the free grid; 20 or 100 tiles of a tiling blocked, one obstacle cell moved or not, seeds
+  0–1), and the free 64 × 62 rectangle with T alone, which has no tiling (T tiles a rectangle only
+  when 4 divides both sides, Walkup 1965) but passes every pre-check.
 
 Every method runs with a time limit per map (``--limits``); "yes" is a tiling (re-checked here:
 tiles are allowed tetrominoes, disjoint, on free cells, covering every free cell), "no" a proof
@@ -22,7 +26,7 @@ map that reaches the compiled sweep) is paid once, before the first timed run (`
 
 ``--extra`` runs ``auto`` alone on 98 more large maps (more seeds of the same generators).
 
-Run:  python benchmarks/bench_tiling.py [--quick] [--extra] [--limits AUTO,BT,CPSAT] [--out FILE]
+Run:  python benchmarks/bench_tiling.py [--quick] [--extra] [--family NAME] [--limits AUTO,BT,CPSAT] [--out FILE]
 """
 
 from __future__ import annotations
@@ -37,12 +41,13 @@ import numpy as np
 
 from htetro_opt.errors import TilingError
 from htetro_opt.model.tiles import identify_tile
-from htetro_opt.solvers.tiling import find_tiles
+from htetro_opt.solvers.tiling import TilingTimeLimitError, find_tiles
 
 METHODS = ("auto", "backtracking", "cpsat")
 TEN_SHAPES = (None, "TZ", "T", "IT", "LJT", "SZ", "IO", "ZT", "LT", "IL", "SZT", "TZ", "IT", "LJT", "T")
 TARGETS = {"10 × 10": 1.0, "T only": 1.0, "scattered 64 × 64": 5.0, "128 × 128 with obstacles": 10.0,
-           "free 256 × 256": 10.0}  # issue 16's targets in seconds ("T only": ours, as for 10 × 10)
+           "free 256 × 256": 10.0, "64 × 64 with few shapes": 5.0}
+# issue 16's targets in seconds ("T only": ours, as for 10 × 10; "few shapes": ours, as for scattered 64 × 64)
 
 
 def _area_fixed(occ: np.ndarray) -> np.ndarray:
@@ -98,14 +103,19 @@ def map_furniture(h: int, w: int, count: int, seed: int) -> np.ndarray:
 
 
 def map_t_only(n: int, blocked: int, moved: bool, seed: int) -> np.ndarray:
-    """An n × n grid (n a multiple of 4) tiled by T (``find_tiles`` shuffled by ``seed``), the cells
-    of ``blocked`` of its tiles (drawn by default_rng(seed)) made obstacles: tileable by T. With
-    ``moved``, one obstacle cell also moves 4 columns (to a free cell, so the count of every class
-    (x mod 4, y mod 4) stays and the colourings still hold): usually untileable, and proving it needs
-    a search."""
+    """``map_restricted`` with T alone."""
+    return map_restricted(n, "T", blocked, moved, seed)
+
+
+def map_restricted(n: int, shapes: str, blocked: int, moved: bool, seed: int) -> np.ndarray:
+    """An n × n grid (n a multiple of 4) tiled by ``shapes`` (``find_tiles`` shuffled by ``seed``),
+    the cells of ``blocked`` of its tiles (drawn by default_rng(seed)) made obstacles: tileable by
+    ``shapes``. With ``moved``, one obstacle cell also moves 4 columns (to a free cell, so the count
+    of every class (x mod 4, y mod 4) stays and the colourings still hold): often untileable, and
+    proving it may need a search."""
     rng = np.random.default_rng(seed)
     occ = np.zeros((n, n), dtype=bool)
-    tiles = find_tiles(occ, shapes="T", shuffle=True, seed=seed)
+    tiles = find_tiles(occ, shapes=shapes, shuffle=True, seed=seed)
     for i in rng.choice(len(tiles), size=blocked, replace=False):
         occ[tiles[i][:, 1], tiles[i][:, 0]] = True
     if moved:
@@ -135,6 +145,13 @@ def families(quick: bool) -> dict[str, list[tuple[str, np.ndarray, str | None]]]
         + [(f"128 × 128, 5 % cells (map_cells seed {s})", map_cells(128, 128, 0.05, s), None) for s in big]
         + [(f"128 × 128, 400 blocks (map_blocks seed {s})", map_blocks(128, 128, 400, s), None) for s in big])
     out["free 256 × 256"] = [("256 × 256 free", np.zeros((256, 256), dtype=bool), None)]
+    few = [(f"64 × 64 free, {shapes} only", map_restricted(64, shapes, 0, False, 0), shapes) for shapes in ("TZ", "O", "I", "T")]
+    for shapes in ("TZ", "O", "I", "T"):
+        few += [(f"64 × 64, {shapes} only, {k} tiles blocked{', one cell moved' if moved else ''} "
+                 f"(map_restricted seed {s})", map_restricted(64, shapes, k, moved, s), shapes)
+                for k in (20, 100) for moved in (False, True) for s in range(1 if quick else 2)]
+    few.append(("64 × 62 free, T only (no tiling: Walkup 1965)", np.zeros((62, 64), dtype=bool), "T"))
+    out["64 × 64 with few shapes"] = few
     return out
 
 
@@ -171,8 +188,10 @@ def run(occ, shapes, method, limit) -> tuple[str, float]:
     began = time.perf_counter()
     try:
         tiles = find_tiles(occ, shapes=shapes, method=method, time_limit=limit)
-    except TilingError as err:
-        return ("limit" if "time limit" in str(err) else "no"), time.perf_counter() - began
+    except TilingTimeLimitError:  # neither a tiling nor a proof within the limit
+        return "limit", time.perf_counter() - began
+    except TilingError:
+        return "no", time.perf_counter() - began
     seconds = time.perf_counter() - began
     check_tiling(occ, tiles, shapes)
     return "yes", seconds
@@ -189,6 +208,7 @@ def main() -> None:
     parser.add_argument("--limits", default="30,5,5",
                         help="time limits in seconds for auto, backtracking and cpsat (default 30,5,5)")
     parser.add_argument("--out", type=Path, help="also write the report (markdown) to this file")
+    parser.add_argument("--family", help="run this family of maps alone (its name, e.g. '64 × 64 with few shapes')")
     parser.add_argument("--extra", action="store_true",
                         help="instead: auto alone on 98 more large maps (extra_maps), its worst time per size")
     args = parser.parse_args()
@@ -217,13 +237,19 @@ def main() -> None:
             args.out.write_text("\n".join(lines) + "\n")
         return
     say(f"# Tiling without tails: {', '.join(METHODS)} (Le et al. 2018's tiling, issue 16 item 6)\n")
-    say(f"`python benchmarks/bench_tiling.py{' --quick' if args.quick else ''} --limits {args.limits}`, "
+    family_flag = f" --family '{args.family}'" if args.family is not None else ""
+    say(f"`python benchmarks/bench_tiling.py{' --quick' if args.quick else ''}{family_flag} --limits {args.limits}`, "
         f"{time.strftime('%Y-%m-%d', time.gmtime())}, Python {platform.python_version()}, {platform.machine()}; "
         f"time limits {', '.join(f'{m} {limits[m]:g} s' for m in METHODS)}. Wall seconds on a shared "
         f"{os.cpu_count()}-core machine (load average at the start {os.getloadavg()[0]:.1f}, this benchmark "
         "counting for 1; others' jobs make the times pessimistic). numba loaded before the first run.\n")
     summary = []
-    for family, maps in families(args.quick).items():
+    chosen = families(args.quick)
+    if args.family is not None:
+        if args.family not in chosen:
+            parser.error(f"--family must be one of {', '.join(repr(f) for f in chosen)}, got {args.family!r}")
+        chosen = {args.family: chosen[args.family]}
+    for family, maps in chosen.items():
         times = {m: [] for m in METHODS}
         verdicts = {m: [] for m in METHODS}
         say(f"## {family}\n")

@@ -42,6 +42,7 @@ from htetro_opt.scenarios import (
 )
 from htetro_opt.solvers.grid_paths import EXACT_METHODS, HEAT_ELEMENTS, PLAN_METHODS, plan_path
 from htetro_opt.solvers.sequencing import SEQUENCE_METHODS, TIME_LIMIT_TEXT, sequence_waypoints
+from htetro_opt.solvers.tiling import DEFAULT_TIME_LIMIT as TILING_TIME_LIMIT  # one bound, the library's
 from htetro_opt.solvers.tiling import TILING_METHODS, tile_workspace
 
 __all__ = ["main", "main_entry", "build_parser"]
@@ -54,7 +55,6 @@ GA_DEFAULTS = {"pop_size": 50, "max_gen": 1000, "patience": None, "converge": "b
 """Defaults of ``plan``'s GA options (None in the parser, so that one given to an exact method is refused;
 None here: plan_ga's default for the algorithm)."""
 GA_PICKS = ("balanced", "fastest", "smoothest", "safest")  # htetro_opt.algorithms.PICKS, without loading pymoo
-TILING_TIME_LIMIT = 60.0  # the backtracker can search long on cluttered maps with few allowed shapes
 
 
 def _add_outputs(p, *, json: str = "print one JSON object", plot: str | None = None, gif: str | None = None) -> None:

@@ -510,6 +510,14 @@ def test_tile_untileable_map_is_one_error_line(capsys, tmp_path, grid, words):
     assert_one_error_line(*run(capsys, ["tile", path]), *words)
 
 
+def test_tile_not_proven_within_the_time_limit_is_one_error_line(capsys, tmp_path):
+    # 64 x 62 has no tiling by T (4 must divide both sides), passes every pre-check, and is not
+    # proven so in half a second: the one error line says that nothing was proven
+    path = scenario(tmp_path / "t_only.toml", grid="\n".join(["." * 64] * 62))
+    assert_one_error_line(*run(capsys, ["tile", path, "--shapes", "T", "--time-limit", "0.5"]),
+                          "proven impossible within the time limit of 0.5 s")
+
+
 def test_tile_unknown_shape_is_one_error_line(capsys, tmp_path):
     path = scenario(tmp_path / "square.toml", grid="....\n....")
     assert_one_error_line(*run(capsys, ["tile", path, "--shapes", "OQ"]), "Q")

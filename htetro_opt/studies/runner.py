@@ -38,8 +38,8 @@ on the first four maps of its Table 6). The options:
   (``[w_t, w_sm, w_sf]`` or ``"w_t,w_sm,w_sf"``), ``t_max``, ``element`` (``"q1"`` or ``"p0"``),
   ``monotone``, ``band`` (``"auto"``, ``"full"`` or a radius in cells) (the heat planner of
   Do et al. 2021, which always plans with the diagonals);
-- ``tile``: method ``backtracking`` or ``cpsat``; ``shapes`` (e.g. ``"TZ"``), ``overlap``,
-  ``shuffle`` (then the trials are seeded), ``time_limit`` (default: none);
+- ``tile``: method ``auto``, ``backtracking`` or ``cpsat``; ``shapes`` (e.g. ``"TZ"``), ``overlap``,
+  ``shuffle`` (then the trials are seeded), ``time_limit`` (default: the library's 60 s);
 - ``sequence``: any sequencing method (``auto``, ``exact``, ``ortools``, ``local``, ``ga``, …);
   ``start`` (a tile label or ``"free"``), ``weights`` (``[a, b, c, d]`` or ``"a,b,c,d"``),
   ``time_limit``, ``shapes`` (for scenarios, which are tiled first);

@@ -5,7 +5,9 @@ exact cover by OR-Tools' CP-SAT, ``"auto"`` (the default) a portfolio: the backt
 sweep repaired by small exact covers, CP-SAT band by band and region by region, with budgets counted
 in steps, so that no map makes it search for long where another method would not. :func:`enumerate_tilings` lists several tilings and
 :func:`find_tiles` returns the bare tiles; a map that cannot be tiled raises a
-:class:`~htetro_opt.errors.TilingError` that says why.
+:class:`~htetro_opt.errors.TilingError` that says why, and one neither tiled nor proven untileable
+within the time limit (:data:`DEFAULT_TIME_LIMIT`, 60 s, when none is given) its subclass
+:class:`TilingTimeLimitError`.
 
 Importing this package imports neither pymoo nor DEAP.
 """
@@ -14,7 +16,8 @@ from htetro_opt._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
     "tile_workspace": "._tiling", "enumerate_tilings": "._tiling", "find_tiles": "._tiling",
-    "TILING_METHODS": "._tiling", "AUTO_STEPS": "._tiling", "BAND_ROWS": "._tiling",
+    "TILING_METHODS": "._tiling", "TilingTimeLimitError": "._tiling", "DEFAULT_TIME_LIMIT": "._tiling",
+    "AUTO_STEPS": "._tiling", "BAND_ROWS": "._tiling",
     "BAND_COMMIT": "._tiling", "BAND_WORK": "._tiling", "SWEEP_CELLS": "._tiling", "SWEEP_POCKET": "._tiling",
     "SWEEP_FINAL": "._tiling", "STRIP_LIFTS": "._tiling", "STRIP_STEPS": "._tiling", "REPAIR_BOXES": "._tiling",
     "REPAIR_WORK": "._tiling", "REPAIR_TRIES": "._tiling",

@@ -54,6 +54,8 @@ Pre-checks
     on one worker with a ``random_seed`` (0, or drawn from ``seed`` with ``shuffle=True``) and the
     pattern order, so a seed gives one tiling, reproducibly, and other seeds others. It takes a few
     seconds on 64 × 64 grids and proves untileability where the backtracker would search for long.
+    Building the model counts against ``time_limit`` (on a free 256 × 256 grid it takes seconds):
+    the clock is read while it is built, and CP-SAT gets what is left.
 
 ``"auto"`` (the default), a portfolio of fixed, machine-independent budgets (a choice of ours)
     Each tiler has its tails (benchmarks/README.md, "Tiling without tails"): the backtracker can
@@ -93,6 +95,14 @@ Pre-checks
     Several tilings (:func:`enumerate_tilings`) go from stage 1 to CP-SAT on the whole map. Every
     budget is counted in steps or CP-SAT's deterministic time, not seconds, so a map gets the same
     tiling on every machine; only ``time_limit`` depends on the clock.
+
+Time limit
+    Every method is exact, and a map can pass every pre-check, have no tiling, and take a search
+    hours to prove it (a 64 × 62 rectangle with T alone, which has none since 4 does not divide 62).
+    So a call is bounded: by ``time_limit``, or by :data:`DEFAULT_TIME_LIMIT` (60 s) when it is None.
+    A search cut short raises :class:`TilingTimeLimitError`, a subclass of
+    :class:`~htetro_opt.errors.TilingError` that says the map may still be tileable; a plain
+    TilingError is a proof that it is not.
 
 Overlapping sub-workspaces (§3.1, Fig. 5d–f)
     "If the size of the coverage area is not a multiple of hTetro blocks, we can segment this
@@ -146,6 +156,7 @@ from htetro_opt.scenarios.tileset import Tileset
 
 __all__ = [
     "AUTO_STEPS",
+    "DEFAULT_TIME_LIMIT",
     "BAND_COMMIT",
     "BAND_ROWS",
     "BAND_WORK",
@@ -161,6 +172,7 @@ __all__ = [
     "SWEEP_FINAL",
     "SWEEP_POCKET",
     "TILING_METHODS",
+    "TilingTimeLimitError",
     "enumerate_tilings",
     "find_tiles",
     "tile_workspace",
@@ -169,6 +181,12 @@ __all__ = [
 TILING_METHODS = ("auto", "backtracking", "cpsat")
 """The tiling methods: a portfolio of the others (the default), the paper's backtracking search and
 OR-Tools CP-SAT."""
+
+DEFAULT_TIME_LIMIT = 60.0
+"""Seconds a tiling may take when ``time_limit`` is None (the library's, the CLI's and the study
+runner's default). Every method is exact, so on a map that passes every pre-check but has no tiling
+the search may have to go through a great many partial tilings before it proves so (a 64 × 64 map
+with T and Z only, say): without a bound such a call could run for hours."""
 
 FLOOD_LIMIT = 4096
 """Most cells the backtracker's pruning flood fill visits before it treats a region as open."""
@@ -182,10 +200,35 @@ MEMO_LIMIT = 1_000_000
 
 _PAD = 3  # a pattern reaches at most 3 cells from its anchor in x and y
 _CHECK_EVERY = 2048  # search steps between two looks at the clock
+_BUILD_CHUNK = 1 << 15  # CP-SAT variables or constraints built between two looks (~0.1 s)
+_LOAD_SHARE = 0.25  # CP-SAT's model load, as a share of the model's build time (see _cpsat_covers)
+
+
+class TilingTimeLimitError(TilingError):
+    """The time limit ran out before a tiling was found or proven impossible: the map may still be
+    tileable (unlike a plain :class:`~htetro_opt.errors.TilingError`, which is a proof that it is not).
+
+    Attributes
+    ----------
+    time_limit : float
+        The limit, in seconds, that ran out.
+    method : str
+        The tiling method that ran.
+    """
+
+    def __init__(self, message: str, *, time_limit: float, method: str) -> None:
+        super().__init__(message)
+        self.time_limit = time_limit
+        self.method = method
 
 
 class _TimeLimit(TilingError):
     """The time limit ran out (the map may still be tileable): never a reason to try a split."""
+
+
+def _check_clock(deadline) -> None:
+    if deadline is not None and _time.perf_counter() > deadline:
+        raise _TimeLimit("time limit")
 
 
 class _OutOfWork(Exception):
@@ -220,15 +263,18 @@ def _check_shapes(shapes) -> tuple[Pattern, ...]:
     return patterns_of(shapes)
 
 
-def _check_options(method, shuffle, seed, time_limit) -> tuple[int | None, float | None]:
-    """The search's order seed (None: the fixed order) and its deadline, all options checked (the
-    seed too when ``shuffle`` is off and it goes unused: a bad value is a mistake either way)."""
+def _check_options(method, shuffle, seed, time_limit) -> tuple[int | None, float, float]:
+    """The search's order seed (None: the fixed order), its deadline and its time limit (None:
+    :data:`DEFAULT_TIME_LIMIT`), all options checked (the seed too when ``shuffle`` is off and it
+    goes unused: a bad value is a mistake either way)."""
     if method not in TILING_METHODS:
         raise ParameterError(f"unknown tiling method {method!r}: expected one of {', '.join(TILING_METHODS)}")
     seed = check_seed(seed)
     order_seed = derive_seed(seed) if check_bool(shuffle, "shuffle") else None
     time_limit = check_time_limit(time_limit)
-    return order_seed, None if time_limit is None else _time.perf_counter() + time_limit
+    if time_limit is None:
+        time_limit = DEFAULT_TIME_LIMIT
+    return order_seed, _time.perf_counter() + time_limit, time_limit
 
 
 # ------------------------------------------------------------------------------------------------
@@ -607,7 +653,10 @@ def _cpsat_covers(must, may, patterns, seed, deadline, limit, work=None):
     most once (every tile touching a ``must`` cell), by CP-SAT; [] when there is none.
 
     Raises _TimeLimit when the deadline comes first, _OutOfWork when ``work`` (CP-SAT's
-    deterministic seconds, the same on every machine) runs out first.
+    deterministic seconds, the same on every machine) runs out first. The model's build counts
+    against the deadline (on a free 256 × 256 grid, 1.2 million placements, it takes seconds in
+    OR-Tools' Python layer), so the clock is read every :data:`_BUILD_CHUNK` variables or constraints
+    and CP-SAT gets only what is left.
     """
     from ortools.sat.python import cp_model
 
@@ -619,22 +668,35 @@ def _cpsat_covers(must, may, patterns, seed, deadline, limit, work=None):
     rank[_pattern_order(len(patterns), seed)] = np.arange(len(patterns))
     by = np.lexsort((rank[which], cells[:, 0, 0], -cells[:, 0, 1]))
     cells = cells[by]
+    began = _time.perf_counter()
     model = cp_model.CpModel()
-    xs = [model.NewBoolVar("") for _ in range(len(cells))]
+    xs = []
+    for start in range(0, len(cells), _BUILD_CHUNK):
+        _check_clock(deadline)
+        xs += [model.NewBoolVar("") for _ in range(min(_BUILD_CHUNK, len(cells) - start))]
     h, w = must.shape
     flat = (cells[..., 1] * w + cells[..., 0]).ravel()
     owner = np.repeat(np.arange(len(cells)), 4)
     by_cell = np.argsort(flat, kind="stable")
     bounds = np.searchsorted(flat[by_cell], np.arange(h * w + 1)).tolist()
     owner = owner[by_cell].tolist()
-    for c in np.flatnonzero(must.ravel()).tolist():
+    for k, c in enumerate(np.flatnonzero(must.ravel()).tolist()):
+        if k % _BUILD_CHUNK == 0:
+            _check_clock(deadline)
         model.AddExactlyOne([xs[i] for i in owner[bounds[c]:bounds[c + 1]]])
-    for c in np.flatnonzero(may.ravel()).tolist():
+    for k, c in enumerate(np.flatnonzero(may.ravel()).tolist()):
+        if k % _BUILD_CHUNK == 0:
+            _check_clock(deadline)
         if bounds[c + 1] - bounds[c] > 1:
             model.AddAtMostOne([xs[i] for i in owner[bounds[c]:bounds[c + 1]]])
     # The backtracker's order, declared as a search strategy: CP-SAT's portfolio (one worker) takes
     # turns between it and its own heuristics at each restart, with propagation and clause learning.
-    model.AddDecisionStrategy(xs, cp_model.CHOOSE_FIRST, cp_model.SELECT_MAX_VALUE)
+    # Declared in chunks with a look at the clock between them (one AddDecisionStrategy call over
+    # 1.2 million variables takes seconds): consecutive CHOOSE_FIRST strategies branch exactly as
+    # one over their concatenation, since CP-SAT moves to the next only when all of one are fixed.
+    for start in range(0, len(xs), _BUILD_CHUNK):
+        _check_clock(deadline)
+        model.AddDecisionStrategy(xs[start:start + _BUILD_CHUNK], cp_model.CHOOSE_FIRST, cp_model.SELECT_MAX_VALUE)
 
     solver = cp_model.CpSolver()
     params = solver.parameters
@@ -653,7 +715,11 @@ def _cpsat_covers(must, may, patterns, seed, deadline, limit, work=None):
     if work is not None:
         params.max_deterministic_time = work
     if deadline is not None:
-        left = deadline - _time.perf_counter()
+        # CP-SAT loads the model without looking at its time limit: on the free 256 x 256 grid the
+        # load took 0.8 s after a 6 s build (it overran a 3.8 s limit to 4.6 s), so a quarter of
+        # the build's time, measured on this machine as it is loaded now, is set aside for it
+        now = _time.perf_counter()
+        left = deadline - now - _LOAD_SHARE * (now - began)
         if left <= 0:
             raise _TimeLimit("time limit")
         params.max_time_in_seconds = left
@@ -1024,12 +1090,13 @@ def _auto_tilings(occ, patterns, seed, deadline, limit):
 
 def _time_message(method, time_limit) -> str:
     if method == "backtracking":
-        return (f"the backtracking search found no tiling within the time limit of {time_limit:g} s; "
-                "try the auto or cpsat method or a longer time limit")
+        return (f"the backtracking search found no tiling and proved none impossible within the time limit of "
+                f"{time_limit:g} s; try the auto or cpsat method or a longer time limit")
     if method == "auto":
         return (f"no tiling found and none proven impossible within the time limit of {time_limit:g} s "
                 "(backtracking, bands, then CP-SAT); try a longer time limit")
-    return f"CP-SAT found no tiling within the time limit of {time_limit:g} s; try a longer time limit"
+    return (f"CP-SAT found no tiling and proved none impossible within the time limit of {time_limit:g} s "
+            "(building its model included); try a longer time limit")
 
 
 def _tilings(occ, patterns, method, seed, deadline, limit):
@@ -1060,9 +1127,9 @@ def _tilings(occ, patterns, method, seed, deadline, limit):
     return found
 
 
-def _retime(method, time_limit) -> TilingError:
+def _retime(method, time_limit) -> TilingTimeLimitError:
     """The error the caller sees when the time limit ran out."""
-    return TilingError(_time_message(method, time_limit))
+    return TilingTimeLimitError(_time_message(method, time_limit), time_limit=time_limit, method=method)
 
 
 def find_tiles(occupancy, *, shapes=None, method: str = "auto", shuffle: bool = False, seed=None,
@@ -1084,7 +1151,8 @@ def find_tiles(occupancy, *, shapes=None, method: str = "auto", shuffle: bool = 
     seed : None, int or numpy.random.Generator
         With ``shuffle``: an int or a Generator gives the same tiling every time, None a fresh one.
     time_limit : float, optional
-        Seconds the search may take; no limit when None.
+        Seconds the search may take, model building included; :data:`DEFAULT_TIME_LIMIT` (60 s)
+        when None.
 
     Returns
     -------
@@ -1093,11 +1161,13 @@ def find_tiles(occupancy, *, shapes=None, method: str = "auto", shuffle: bool = 
 
     Raises
     ------
+    TilingTimeLimitError
+        If the time limit runs out first: neither a tiling nor a proof that none exists was found
+        (a subclass of TilingError, so catch it first to tell the two apart).
     TilingError
         If a pre-check fails (no free cell; free area, or a 4-connected region's area, not a multiple
-        of 4; unequal checkerboard colours without T; a cell no allowed tile fits over), if no tiling
-        exists, or if the time limit runs out first (the message then says that neither a tiling
-        nor a proof that none exists was found).
+        of 4; unequal checkerboard colours without T; a cell no allowed tile fits over) or no tiling
+        exists: a proof that the map cannot be tiled.
     UnknownShapeError
         If a shape name is unknown.
     ParameterError
@@ -1111,7 +1181,7 @@ def find_tiles(occupancy, *, shapes=None, method: str = "auto", shuffle: bool = 
     """
     occ, _ = _as_occupancy(occupancy, "occupancy")
     patterns = _check_shapes(shapes)
-    seed, deadline = _check_options(method, shuffle, seed, time_limit)
+    seed, deadline, time_limit = _check_options(method, shuffle, seed, time_limit)
     try:
         return _tilings(occ, patterns, method, seed, deadline, 1)[0]
     except _TimeLimit as err:
@@ -1214,7 +1284,7 @@ def tile_workspace(workspace, *, shapes=None, method: str = "auto", shuffle: boo
     """
     occ, cell_size = _as_occupancy(workspace, "workspace")
     patterns = _check_shapes(shapes)
-    seed, deadline = _check_options(method, shuffle, seed, time_limit)
+    seed, deadline, time_limit = _check_options(method, shuffle, seed, time_limit)
     check_weights(weights)
     overlap = check_bool(overlap, "overlap")
     if not isinstance(name, str):
@@ -1259,8 +1329,10 @@ def enumerate_tilings(workspace, *, shapes=None, limit: int = 10, method: str = 
 
     Raises
     ------
+    TilingTimeLimitError
+        If the time limit runs out before the first tiling (and before a proof that there is none).
     TilingError
-        If the map has no tiling, or the time limit runs out before the first.
+        If the map has no tiling.
     UnknownShapeError, ParameterError
         On invalid options (``limit`` not a positive integer, among others).
 
@@ -1272,7 +1344,7 @@ def enumerate_tilings(workspace, *, shapes=None, limit: int = 10, method: str = 
     occ, cell_size = _as_occupancy(workspace, "workspace")
     patterns = _check_shapes(shapes)
     limit = check_int(limit, "limit", minimum=1)
-    _, deadline = _check_options(method, False, None, time_limit)
+    _, deadline, time_limit = _check_options(method, False, None, time_limit)
     check_weights(weights)
     try:
         found = _tilings(occ, patterns, method, None, deadline, limit)

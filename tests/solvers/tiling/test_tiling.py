@@ -2,6 +2,8 @@
 search, on the paper's workspaces, and the overlapping sub-workspace option of its Fig. 5."""
 
 import re
+import sys
+import time
 
 import numpy as np
 import pytest
@@ -13,7 +15,9 @@ from htetro_opt.model import Workspace
 from htetro_opt.model.tiles import PATTERNS, identify_tile, scan_key
 from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers.tiling import (
+    DEFAULT_TIME_LIMIT,
     TILING_METHODS,
+    TilingTimeLimitError,
     enumerate_tilings,
     find_tiles,
     tile_workspace,
@@ -463,16 +467,56 @@ def test_colourings_of_tiling_theory(method):
 
 @pytest.mark.parametrize("method", METHODS)
 def test_untileable_map_passing_every_precheck(method):
-    with pytest.raises(TilingError, match=r"no tiling of the 36 free cells by ZT tetrominoes exists"):
+    with pytest.raises(TilingError, match=r"no tiling of the 36 free cells by ZT tetrominoes exists") as info:
         find_tiles(np.zeros((6, 6), dtype=bool), shapes="TZ", method=method)
+    assert not isinstance(info.value, TilingTimeLimitError)  # a proof, not a time-out
 
 
 @pytest.mark.parametrize("method", METHODS)
 def test_time_limit_is_reported(method):
-    with pytest.raises(TilingError, match="time limit") as info:
+    with pytest.raises(TilingTimeLimitError, match="time limit") as info:
         find_tiles(np.zeros((16, 16), dtype=bool), method=method, time_limit=1e-9)
+    assert (info.value.method, info.value.time_limit) == (method, 1e-9)
     if method == "backtracking":
         assert "cpsat" in str(info.value)
+
+
+# T tiles an m x n rectangle only when 4 divides both sides (Walkup 1965), so a 64 x 62 rectangle
+# has no tiling by T, yet it passes every pre-check (area, colourings, the mod-4 lattice) and no
+# method proves it quickly (auto took 23.5 s, backtracking and CP-SAT over 5 s: bench_tiling.py):
+# the map the time limit is for
+T_ONLY_64X62 = np.zeros((62, 64), dtype=bool)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_untileable_map_hard_to_prove_is_reported_as_not_proven(method):
+    began = time.perf_counter()
+    with pytest.raises(TilingTimeLimitError, match=r"impossible within the time limit of 0\.5 s") as info:
+        tile_workspace(T_ONLY_64X62, shapes="T", method=method, time_limit=0.5)
+    assert time.perf_counter() - began < 0.5 + 1.0
+    assert isinstance(info.value, TilingError)  # callers that catch TilingError still catch it
+
+
+def test_no_time_limit_means_the_default_bound(monkeypatch):
+    assert DEFAULT_TIME_LIMIT == 60.0
+    # the constant is read at each call: a short one here stands for the 60 s a user would wait
+    monkeypatch.setattr(sys.modules[tile_workspace.__module__], "DEFAULT_TIME_LIMIT", 0.3)
+    began = time.perf_counter()
+    with pytest.raises(TilingTimeLimitError, match="time limit of 0.3 s") as info:
+        tile_workspace(T_ONLY_64X62, shapes="T")
+    assert time.perf_counter() - began < 0.3 + 1.0
+    assert info.value.time_limit == 0.3
+
+
+@pytest.mark.parametrize("n, limit", [(256, 1.5), (128, 2.0)])
+def test_cpsat_counts_building_its_model_against_the_time_limit(n, limit):
+    # 1.2 million placements on 256 x 256 take ~6 s to build: the build is cut short; on 128 x 128
+    # it ends in time and CP-SAT gets the rest; neither tiles in the time (CP-SAT is slow on large
+    # free maps), so the call must end at the limit, not seconds after it
+    began = time.perf_counter()
+    with pytest.raises(TilingTimeLimitError, match="CP-SAT"):
+        find_tiles(np.zeros((n, n), dtype=bool), method="cpsat", time_limit=limit)
+    assert time.perf_counter() - began < limit + 0.75
 
 
 def test_invalid_options():
