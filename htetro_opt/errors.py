@@ -18,6 +18,7 @@ __all__ = [
     "ParameterError",
     "TilesetFormatError",
     "TilingError",
+    "TilingTimeLimitError",
     "OutputError",
 ]
 
@@ -62,6 +63,24 @@ class TilesetFormatError(MapFormatError):
 
 class TilingError(PlanningError):
     """A workspace cannot be tiled with the allowed tetrominoes (area, parity, an isolated region)."""
+
+
+class TilingTimeLimitError(TilingError):
+    """The time limit ran out before a tiling was found or proven impossible: the map may still be
+    tileable (unlike a plain :class:`TilingError`, which is a proof that it is not).
+
+    Attributes
+    ----------
+    time_limit : float
+        The limit, in seconds, that ran out.
+    method : str
+        The tiling method that ran.
+    """
+
+    def __init__(self, message: str, *, time_limit: float, method: str) -> None:
+        super().__init__(message)
+        self.time_limit = time_limit
+        self.method = method
 
 
 class ParameterError(HtetroError, ValueError):

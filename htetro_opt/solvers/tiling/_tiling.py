@@ -144,7 +144,7 @@ from htetro_opt._validation import (
     check_time_limit,
     derive_seed,
 )
-from htetro_opt.errors import ParameterError, ScenarioError, TilingError
+from htetro_opt.errors import ParameterError, ScenarioError, TilingError, TilingTimeLimitError
 from htetro_opt.model.tiles import Pattern, patterns_of
 from htetro_opt.model.workspace import Workspace
 from htetro_opt.problems.waypoint_sequencing import (
@@ -202,24 +202,6 @@ _PAD = 3  # a pattern reaches at most 3 cells from its anchor in x and y
 _CHECK_EVERY = 2048  # search steps between two looks at the clock
 _BUILD_CHUNK = 1 << 15  # CP-SAT variables or constraints built between two looks (~0.1 s)
 _LOAD_SHARE = 0.25  # CP-SAT's model load, as a share of the model's build time (see _cpsat_covers)
-
-
-class TilingTimeLimitError(TilingError):
-    """The time limit ran out before a tiling was found or proven impossible: the map may still be
-    tileable (unlike a plain :class:`~htetro_opt.errors.TilingError`, which is a proof that it is not).
-
-    Attributes
-    ----------
-    time_limit : float
-        The limit, in seconds, that ran out.
-    method : str
-        The tiling method that ran.
-    """
-
-    def __init__(self, message: str, *, time_limit: float, method: str) -> None:
-        super().__init__(message)
-        self.time_limit = time_limit
-        self.method = method
 
 
 class _TimeLimit(TilingError):

@@ -54,6 +54,27 @@ def tiling_key(tiles):
     return frozenset(tuple(sorted(map(tuple, np.asarray(t).tolist()))) for t in tiles)
 
 
+def area_fixed(occ):
+    """Block the first free cells (numpy order) until the free area is a multiple of 4, in place."""
+    ys, xs = np.nonzero(~occ)
+    k = int((~occ).sum() % 4)
+    occ[ys[:k], xs[:k]] = True
+    return occ
+
+
+def assert_agrees_with_naive_search(occ, shapes):
+    """auto finds a tiling exactly when the unpruned search does (never stopping on its clock), and
+    every tiling it returns is an exact cover."""
+    truth = (~occ).any() and naive_tileable(occ, shapes)
+    try:
+        tiles = find_tiles(occ, shapes=shapes)
+    except TilingError as err:
+        assert not truth and "time limit" not in str(err)
+    else:
+        assert truth
+        assert_exact_cover(occ, tiles, shapes)
+
+
 def naive_tileable(occ, shapes=None):
     """Independent oracle: plain recursive exact cover over sets, no pruning at all."""
     offsets = [[tuple(c) for c in p.cells.tolist()] for p in PATTERNS if shapes is None or p.shape in shapes]
@@ -245,17 +266,8 @@ def test_band_stage_agrees_with_naive_search(tiny_bands, data, w, h, shapes):
     obstacles = data.draw(st.sets(st.integers(0, w * h - 1), max_size=w * h // 5))
     occ = np.zeros(w * h, dtype=bool)
     occ[list(obstacles)] = True
-    occ = occ.reshape(h, w)
-    ys, xs = np.nonzero(~occ)
-    occ[ys[:(~occ).sum() % 4], xs[:(~occ).sum() % 4]] = True
-    truth = (~occ).any() and naive_tileable(occ, shapes)
-    try:
-        tiles = find_tiles(occ, shapes=shapes)
-    except TilingError as err:
-        assert not truth and "time limit" not in str(err)
-    else:
-        assert truth
-        assert_exact_cover(occ, tiles, shapes)
+    occ = area_fixed(occ.reshape(h, w))
+    assert_agrees_with_naive_search(occ, shapes)
 
 
 def test_auto_time_limit_says_nothing_was_proven():
@@ -341,26 +353,15 @@ def test_sweep_stage_agrees_with_naive_search(small_sweep, data, w, h, shapes):
     obstacles = data.draw(st.sets(st.integers(0, w * h - 1), max_size=w * h // 6))
     occ = np.zeros(w * h, dtype=bool)
     occ[list(obstacles)] = True
-    occ = occ.reshape(h, w)
-    ys, xs = np.nonzero(~occ)
-    occ[ys[:(~occ).sum() % 4], xs[:(~occ).sum() % 4]] = True
-    truth = (~occ).any() and naive_tileable(occ, shapes)
-    try:
-        tiles = find_tiles(occ, shapes=shapes)
-    except TilingError as err:
-        assert not truth and "time limit" not in str(err)
-    else:
-        assert truth
-        assert_exact_cover(occ, tiles, shapes)
+    occ = area_fixed(occ.reshape(h, w))
+    assert_agrees_with_naive_search(occ, shapes)
 
 
 def test_the_sweep_stage_tiles_small_maps(small_sweep):
     """The hypothesis test above is only worth something if the sweep itself tiles some maps."""
     rng = np.random.default_rng(5)
     for _ in range(20):
-        occ = rng.random((8, 8)) < 0.1
-        ys, xs = np.nonzero(~occ)
-        occ[ys[:(~occ).sum() % 4], xs[:(~occ).sum() % 4]] = True
+        occ = area_fixed(rng.random((8, 8)) < 0.1)
         try:
             assert_exact_cover(occ, find_tiles(occ))
         except TilingError:
@@ -389,16 +390,8 @@ def test_region_by_region_agrees_with_naive_search(regions_only, data, w, h, sha
     occ = occ.reshape(h, 2 * w)
     occ = np.concatenate([occ[:, :w], np.ones((h, 1), dtype=bool), occ[:, w:]], axis=1)
     for part in (occ[:, :w], occ[:, w + 1:]):  # views: each region's area a multiple of 4
-        ys, xs = np.nonzero(~part)
-        part[ys[:(~part).sum() % 4], xs[:(~part).sum() % 4]] = True
-    truth = (~occ).any() and naive_tileable(occ, shapes)
-    try:
-        tiles = find_tiles(occ, shapes=shapes)
-    except TilingError as err:
-        assert not truth and "time limit" not in str(err)
-    else:
-        assert truth
-        assert_exact_cover(occ, tiles, shapes)
+        area_fixed(part)
+    assert_agrees_with_naive_search(occ, shapes)
 
 
 # ------------------------------------------------------------------------------------------------
