@@ -48,8 +48,9 @@ on the first four maps of its Table 6). The options:
   such as ``["O", "hI"]``; default the paper's O, vI, hI), ``start`` (``"scenario"``: the roadmap's
   first and last poses, as on the command line, or ``"auto"``), ``clearance``; ``stripes`` (a width
   or widths bottom up, ``[2, 3, 2]`` or ``"2,3,2"``, checked against every scenario's height),
-  ``region_columns``, ``budget`` (the stripes methods); ``time_limit`` (the stripes methods and
-  ``tiling-tsp``). Every coverage method is deterministic: its trials run once.
+  ``region_columns``, ``budget``, ``ends`` (``"sweep"`` or ``"both"``) (the stripes methods);
+  ``mopup`` (``"sequenced"`` or ``"nearest"``; the stripes methods and ``boustrophedon``);
+  ``time_limit`` (the stripes methods and ``tiling-tsp``). Every coverage method is deterministic: its trials run once.
 
 Seeds come from the study, never from a method entry. The whole study is checked before any trial
 runs (:class:`StudyError` names the file, the method entry ``methods[i]``, counted from 0, and the
@@ -413,6 +414,18 @@ def _convergence_measures() -> tuple[str, ...]:
     return tuple(CONVERGENCE_MEASURES)
 
 
+def _coverage_ends() -> tuple[str, ...]:
+    from htetro_opt.solvers.coverage import ENDS
+
+    return tuple(ENDS)
+
+
+def _mopup_orders() -> tuple[str, ...]:
+    from htetro_opt.solvers.coverage import MOPUP_ORDERS
+
+    return tuple(MOPUP_ORDERS)
+
+
 def _check_cover_start(value, name: str) -> str:
     if value not in ("scenario", "auto"):
         raise ParameterError(f"{name} must be 'scenario' (the roadmap's first and last poses) or 'auto' (the "
@@ -483,6 +496,8 @@ _OPTIONS: dict[str, dict[str, tuple[Callable, str | None]]] = {
         "stripes": (_check_stripes, "stripes"),
         "region_columns": (lambda v, n: check_int(v, n, minimum=1), "stripes"),
         "budget": (lambda v, n: check_int(v, n, minimum=1), "stripes"),
+        "ends": (_check_choice(_coverage_ends, "where a stripe may be left"), "stripes"),
+        "mopup": (_check_choice(_mopup_orders, "the order of the mop-up's targets"), ("stripes", "boustrophedon")),
         "time_limit": (check_time_limit, ("stripes", "tiling-tsp")),
     },
 }
@@ -493,7 +508,8 @@ _SCOPE_NAMES = {"exact": "the exact methods (dijkstra, astar)", "heat": "the hea
                 "ga": "the GA methods", _HTETRO_GA: "the hTetro-GA methods (htetro-ga, htetro-ga-paper)",
                 _PYMOO_GA: "pymoo's algorithms (nsga2, nsga3, smsemoa, agemoea)",
                 "stripes": "the stripes methods (stripes, stripes-paper)",
-                ("stripes", "tiling-tsp"): "the stripes methods (stripes, stripes-paper) and tiling-tsp"}
+                ("stripes", "tiling-tsp"): "the stripes methods (stripes, stripes-paper) and tiling-tsp",
+                ("stripes", "boustrophedon"): "the stripes methods (stripes, stripes-paper) and boustrophedon"}
 
 
 def _takes(task: str, method: str, scope: str | tuple[str, ...] | None) -> bool:

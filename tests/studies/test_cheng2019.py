@@ -116,6 +116,12 @@ BAD = {
                               ["methods[1]", "budget", "not to tiling-tsp"]),
     "time limit for the boustrophedon": ('[[methods]]\nmethod = "boustrophedon"\ntime_limit = 5\n',
                                          ["methods[1]", "time_limit", "and tiling-tsp", "not to boustrophedon"]),
+    "unknown ends": ('ends = "middle"\n', ["ends", "sweep, both", "'middle'"]),
+    "unknown mop-up order": ('mopup = "random"\n', ["mopup", "sequenced, nearest", "'random'"]),
+    "ends for the boustrophedon": ('[[methods]]\nmethod = "boustrophedon"\nends = "both"\n',
+                                   ["methods[1]", "ends", "not to boustrophedon"]),
+    "mop-up order for tiling-tsp": ('[[methods]]\nmethod = "tiling-tsp"\nmopup = "nearest"\n',
+                                    ["methods[1]", "mopup", "not to tiling-tsp"]),
     "unknown method": ('[[methods]]\nmethod = "spiral"\n', ["methods[1]", "unknown cover method 'spiral'",
                                                            "boustrophedon"]),
     "seed in an entry": ("seed = 1\n", ["seed", "seeds"]),
@@ -208,6 +214,15 @@ def test_options_reach_the_planner():
     free_end = plan_coverage(scenario.workspace, "O,hI", stripes=(2, 3, 2))
     assert auto["commands"] == ",".join(free_end.tokens) and auto["commands"] != record["commands"]
     assert "gap" not in auto and auto["lower_bound"] == 25  # (102 - 4) / 4, rounded up
+    both = run_trial("cover", "coverage_16x7", "stripes", {"shapes": "O,hI", "ends": "both", "mopup": "nearest"},
+                     None)
+    folded = plan_coverage(scenario.workspace, "O,hI", ends="both", mopup="nearest", start=scenario.start,
+                           goal=scenario.goal)
+    assert both["commands"] == ",".join(folded.tokens) and both["action_cost"] == folded.action_cost
+    nearest = run_trial("cover", "coverage_16x7", "boustrophedon", {"shapes": "O", "mopup": "nearest"}, None)
+    assert nearest["commands"] == ",".join(plan_coverage(scenario.workspace, "O", method="boustrophedon",
+                                                         mopup="nearest", start=scenario.start,
+                                                         goal=scenario.goal).tokens)
     with pytest.raises(ParameterError, match="cover"):
         run_reference("cover", "coverage_16x7", {})
     gapped = Study(name="g", task="cover", scenarios=["coverage_16x7"], metrics=["gap"], methods=[{"method": "stripes"}])
