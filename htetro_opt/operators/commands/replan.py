@@ -468,7 +468,19 @@ def replan_rows(reached, time, members: int, *, random_state: np.random.Generato
     return np.r_[best, np.sort(drawn)].astype(np.int64)
 
 
-class CommandReplan(Mutation):
+class _GraphPerSimulator:
+    """Keeps each simulator's :class:`TransitionGraph` while the simulator lives (a problem's graph is
+    built once, not once a generation)."""
+
+    def graph(self, simulator: Simulator) -> TransitionGraph:
+        """The simulator's :class:`TransitionGraph`, built on first use."""
+        graphs = self.__dict__.setdefault("_graphs", weakref.WeakKeyDictionary())
+        if simulator not in graphs:
+            graphs[simulator] = TransitionGraph(simulator)
+        return graphs[simulator]
+
+
+class CommandReplan(_GraphPerSimulator, Mutation):
     """Windowed exact re-planning as a pymoo mutation (see :func:`replan_windows`).
 
     Builds the :class:`TransitionGraph` of a problem's simulator once and keeps it while the
@@ -496,20 +508,13 @@ class CommandReplan(Mutation):
         super().__init__(prob=check_probability(prob, "replan prob"))
         self.window = check_int(window, "replan window", minimum=1)
         self.timed = check_bool(timed, "timed")
-        self._graphs: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-    def graph(self, simulator: Simulator) -> TransitionGraph:
-        """The simulator's :class:`TransitionGraph`, built on first use."""
-        if simulator not in self._graphs:
-            self._graphs[simulator] = TransitionGraph(simulator)
-        return self._graphs[simulator]
 
     def _do(self, problem, X, *args, random_state=None, **kwargs):
         return as_column(replan_windows(problem, sequences(X), window=self.window, random_state=random_state,
                                         graph=self.graph(problem.simulator), timed=self.timed))
 
 
-class CommandReachRepair(Mutation):
+class CommandReachRepair(_GraphPerSimulator, Mutation):
     """The reach repair as a pymoo mutation (see :func:`reach_repair`).
 
     Ours, not part of the paper's hTetro-GA: the hTetro-GA applies it to the member nearest to the
@@ -529,13 +534,6 @@ class CommandReachRepair(Mutation):
     def __init__(self, *, tries: int = 3, prob: float = 1.0) -> None:
         super().__init__(prob=check_probability(prob, "reach repair prob"))
         self.tries = check_int(tries, "reach repair tries", minimum=1)
-        self._graphs: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-    def graph(self, simulator: Simulator) -> TransitionGraph:
-        """The simulator's :class:`TransitionGraph`, built on first use."""
-        if simulator not in self._graphs:
-            self._graphs[simulator] = TransitionGraph(simulator)
-        return self._graphs[simulator]
 
     def _do(self, problem, X, *args, random_state=None, **kwargs):
         return as_column(reach_repair(problem, sequences(X), graph=self.graph(problem.simulator), tries=self.tries))
