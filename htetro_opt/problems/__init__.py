@@ -3,7 +3,7 @@
 - :mod:`~htetro_opt.problems.command_path` (Cheng et al. 2020): variable-length motion-command
   chromosomes with the four fitnesses of eqs. 3–6, as a pymoo problem;
 - :mod:`~htetro_opt.problems.heat_costs` (Do et al. 2021): the paper's weighted costs (eqs. 9–12, the
-  safety of its Fig. 5) of any path, for its heat-conduction planner (in progress) and for comparing
+  safety of its Fig. 5) of any path, for its heat-conduction planner and for comparing
   every planner on them;
 - :mod:`~htetro_opt.problems.waypoint_sequencing` (Le et al. 2018): tile waypoints (Algorithm 1), the
   eq.-2 block-displacement cost and the open-path TSP over them, for every sequencing method, plus
@@ -21,8 +21,8 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     **{name: ".command_path" for name in
        ("CommandPathProblem", "FITNESS_NAMES", "SAFETY_COEFFICIENT", "SAFETY_PATTERN", "safety_field")},
     **{name: ".waypoint_sequencing" for name in
-       ("DEFAULT_BLOCK_WEIGHTS", "SequencingInstance", "block_locations", "check_weights", "cost_matrix",
-        "path_cost", "check_instance")},
+       ("DEFAULT_BLOCK_WEIGHTS", "DENSE_LIMIT", "SequencingInstance", "block_locations", "check_weights",
+        "cost_matrix", "eq2_legs", "path_cost", "check_instance")},
     "SequencingProblem": "._sequencing_problem",
     **{name: ".path_bases" for name in
        ("PathBasesProblem", "PATH_KINDS", "SAFETY_KINDS", "OBJECTIVE_KINDS", "DEFAULT_PATH_WEIGHTS",

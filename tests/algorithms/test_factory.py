@@ -127,7 +127,8 @@ def test_replan_mating_adds_the_fastest_members_exact_window_to_the_offspring():
     X = as_column([detour, wander])
     pop = Population.new(X=X, F=problem.evaluate(X), rank=np.array([0, 1]), crowding=np.array([np.inf, np.inf]))
     algorithm = make_algorithm("nsga2", 2, replan_window=6, replan_members=0)
-    off = algorithm.mating.do(problem, pop, 2, random_state=np.random.default_rng(0), algorithm=algorithm)
+    algorithm.setup(problem, seed=0)  # pymoo's selection draws from the algorithm's stream, not numpy's global one
+    off = algorithm.mating.do(problem, pop, 2, random_state=algorithm.random_state, algorithm=algorithm)
     oracle = plan_exact(ws, [start, goal])
     offspring = [format_commands(x) for x in sequences(off.get("X"))]
     assert format_commands(oracle.commands) in offspring and len(off) <= 3

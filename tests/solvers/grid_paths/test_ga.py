@@ -218,8 +218,33 @@ def test_cli_ga_flags(capsys):
     (["--method", "heat", "--replan-window", "5"], "--replan-window"),
     (["--method", "htetro-ga", "--converge", "volume"], "--converge"),
     (["--method", "dijkstra", "--converge", "hypervolume"], "--converge"),
+    (["--method", "htetro-ga", "--conservative"], "--conservative"),
+    (["--method", "htetro-ga-paper", "--conservative"], "--conservative"),
+    (["--method", "dijkstra", "--conservative"], "--conservative"),
 ])
 def test_cli_bad_ga_flags_exit_2(capsys, argv, flag):
     code, out, err = cli(capsys, ["plan", "three_slit", *argv, "--quiet"])
     assert code == 2 and out == "" and err.startswith("error: ") and len(err.splitlines()) == 1
     assert flag in err
+
+
+def test_cli_conservative_reaches_pymoos_algorithms(capsys, monkeypatch):
+    import json
+
+    from htetro_opt.algorithms import ConservativeMating
+    from htetro_opt.solvers.grid_paths import _ga
+
+    made, make = [], _ga.make_algorithm
+
+    def spy(*args, **kwargs):  # records the algorithms plan_ga builds
+        made.append(make(*args, **kwargs))
+        return made[-1]
+
+    monkeypatch.setattr(_ga, "make_algorithm", spy)
+    for flags, expected in (([], False), (["--conservative"], True)):
+        made.clear()
+        code, out, err = cli(capsys, ["plan", "three_slit", "--method", "nsga2", "--pop-size", "8", "--max-gen", "2",
+                                      *flags, "--json", "--quiet"])
+        assert code == 0, err
+        assert json.loads(out)["method"] == "nsga2"
+        assert made and all(isinstance(a.mating, ConservativeMating) is expected for a in made)
