@@ -5,6 +5,9 @@
 - ``"htetro-ga"``, ``"htetro-ga-paper"``, ``"nsga2"``, ``"nsga3"``, ``"smsemoa"``, ``"agemoea"``
   (:func:`plan_ga`): Cheng et al. 2020's multi-objective GA over motion-command chromosomes, or one
   of pymoo's algorithms over the same problem, leg by leg.
+- :func:`plan_max_fitness_sum` (not a ``plan_path`` method: one leg, start to goal): the exact
+  maximum of the GA's fitness sum f_gr + f_t + f_sm + f_sf under its own objective, the reference of
+  its balanced pick.
 
 - ``"heat"`` (:func:`plan_heat`): Do et al. 2021's heat-conduction planner, a search that climbs
   each leg's temperature field (:func:`solve_heat_field`, scikit-fem's bilinear element or
@@ -21,6 +24,7 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "Plan": "._result", "FrontMember": "._result", "LegResult": "._result",
     "plan_exact": "._exact", "EXACT_METHODS": "._exact",
     "plan_ga": "._ga",
+    "plan_max_fitness_sum": "._fitness_sum",
     "plan_heat": "._heat", "HEAT_ENGINES": "._heat", "BAND_SEEDS": "._heat",
     "replan_heat": "._replan", "HeatRun": "._replan",
     "solve_heat_field": "._heat_field", "HeatField": "._heat_field", "HEAT_ELEMENTS": "._heat_field",
