@@ -35,7 +35,10 @@ def digest(X, F) -> str:
 # algorithm: these change only when the algorithm does, and then on purpose).
 RECORDED = {
     ("three_slit", "htetro-ga", 0): ("614c12a8a1e991bb", 3547),
-    ("random", "htetro-ga", 1): ("dd1447ed937d0215", 3706),
+    # recorded again when the re-planning's static search became an A* (the same optimum times, another
+    # choice among equally fast paths, one with fewer command changes: this run's windows are re-planned
+    # onto other paths of the same times)
+    ("random", "htetro-ga", 1): ("7e29b672fc583676", 3609),
     # moving obstacles, recorded again when the re-planning step's time-expanded search became the
     # default (the static-only step still gives the old record: see the test below)
     ("parallel_dynamic", "htetro-ga", 0): ("408d055d85902cef", 4070),

@@ -1,6 +1,8 @@
 """Windowed exact re-planning: keeps the start and the end pose, never slower, re-validates, and a
-window holding a detour becomes the exact optimum between its ends (oracle: plan_exact). The reach
-repair: the repaired path reaches at its times, its tail is the exact optimum from the pose kept."""
+window holding a detour becomes the exact optimum between its ends (oracle: plan_exact). The static
+search (an A*) finds scipy's Dijkstra time within any limit, by a path that replays in the simulator,
+the same path for the same question. The reach repair: the repaired path reaches at its times, its
+tail is the exact optimum from the pose kept."""
 
 from __future__ import annotations
 
@@ -9,6 +11,7 @@ import random
 import numpy as np
 import pytest
 from pymoo.core.population import Population
+from scipy.sparse.csgraph import dijkstra
 
 from htetro_opt.errors import ParameterError
 from htetro_opt.model import (
@@ -31,6 +34,7 @@ from htetro_opt.operators.commands import (
     replan_windows,
     sequences,
 )
+from htetro_opt.operators.commands.replan import _astar
 from htetro_opt.problems import CommandPathProblem
 from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers.grid_paths import plan_exact
@@ -316,7 +320,7 @@ def check_reach_repair(problem, seqs, out):
         common = min(common, int(before.executed[k]))
         tail = float(problem.durations[new].sum())
 
-        def exact_from(i):
+        def exact_from(i, trace=trace):  # this member's poses, bound now
             return plan_exact(sim, [as_pose(trace[i]), problem.goal], t0=problem.t0 + i).time
 
         assert any(abs(tail - float(problem.durations[new[:i]].sum()) - exact_from(i)) < 1e-9
@@ -373,3 +377,126 @@ def test_reach_repair_operator_draws_nothing_but_pymoos_prob_and_builds_its_grap
     assert op.graph(problem.simulator) is graph
     with pytest.raises(ParameterError, match="tries"):
         CommandReachRepair(tries=0)
+
+
+# --- the static search (an A*) against scipy's Dijkstra ------------------------------------------------
+def static_questions(sim, rng, n):
+    """``n`` (source, target, limit) questions between collision-free poses: half of the targets drawn
+    among the poses scipy's Dijkstra reaches within the limit (so most have an answer), half anywhere
+    (so many have none)."""
+    matrix = TransitionGraph(sim)._graph()[0]
+    free = np.array([p for p in rng.choice(sim.n_poses, 4 * n, replace=False) if not sim.pose_conflicts(int(p))])
+    questions = []
+    for k in range(n):
+        source, limit = int(free[k % len(free)]), float(rng.integers(1, 61))
+        reached = np.flatnonzero(np.isfinite(dijkstra(matrix, indices=source, limit=limit)))
+        target = int(rng.choice(reached)) if k % 2 else int(rng.choice(free))
+        questions.append((source, target, limit))
+    return questions
+
+
+@pytest.mark.parametrize("name", ["three_slit", "random", "h_shape"])
+def test_the_static_search_finds_scipys_dijkstra_time_and_a_path_that_replays_in_it(name):
+    # oracle: scipy's Dijkstra bounded by the same limit (inf: no path within it); the path found is
+    # replayed in the simulator from the source, and must end on the target in exactly that time
+    sim = Simulator(load_scenario(name).workspace, commands=SEED000_COMMANDS)
+    graph, matrix = TransitionGraph(sim), TransitionGraph(sim)._graph()[0]
+    rng = np.random.default_rng(len(name))
+    answered = unanswered = 0
+    for source, target, limit in static_questions(sim, rng, 80):
+        oracle = dijkstra(matrix, indices=source, limit=limit)[target]
+        found = graph.fastest(source, 0, target, 0, limit=limit)
+        if not np.isfinite(oracle):
+            assert found == []
+            unanswered += 1
+            continue
+        [(commands, time)] = found
+        run = sim.run([commands], source)
+        assert time == oracle  # integer durations: exact
+        assert run.valid[0] and run.executed[0] == len(commands)
+        assert run.trace[0, len(commands)] == target and run.time[0] == time
+        answered += 1
+    assert answered >= 30 and unanswered >= 5  # both kinds of question were asked
+
+
+def test_the_static_search_is_exact_with_diagonals_and_with_the_block_commands():
+    # the heuristic is derived from the commands: diagonals move two cells of grid distance in √2 s
+    # (0.707 s a cell), Cheng et al. 2019's block commands turn through intermediate states
+    ws = load_scenario("spiral").workspace
+    blocks = list(SEED000_COMMANDS) + ["1l", "1r", "3l", "3r"]
+    for sim in (Simulator(ws, diagonals=True), Simulator(ws, commands=blocks)):
+        graph, matrix = TransitionGraph(sim), TransitionGraph(sim)._graph()[0]
+        answered = 0
+        for source, target, limit in static_questions(sim, np.random.default_rng(4), 40):
+            oracle = dijkstra(matrix, indices=source, limit=limit)[target]
+            found = graph.fastest(source, 0, target, 0, limit=limit)
+            assert bool(found) == bool(np.isfinite(oracle))
+            if found:
+                [(commands, time)] = found
+                run = sim.run([commands], source)
+                # √2 sums in another order, or over another path as fast: equal up to rounding
+                assert time == pytest.approx(oracle, rel=1e-12, abs=1e-12)
+                assert run.valid[0] and run.trace[0, len(commands)] == target and run.time[0] == pytest.approx(time)
+                answered += 1
+        assert answered >= 10
+
+
+@pytest.mark.parametrize("options", [{"commands": SEED000_COMMANDS}, {"diagonals": True}])
+def test_the_static_searchs_heuristic_is_a_consistent_lower_bound(options):
+    # oracle: scipy's Dijkstra on the reversed graph, the exact time from every pose to the target
+    sim = Simulator(load_scenario("three_slit").workspace, **options)
+    graph = TransitionGraph(sim)
+    matrix = graph._graph()[0]
+    cell_time, turn_time = graph._heuristic()
+    width, cells = sim.workspace.width, sim.workspace.width * sim.workspace.height
+    poses = np.arange(sim.n_poses)
+    tails = np.repeat(poses, np.diff(matrix.indptr))
+    for target in np.random.default_rng(1).choice(sim.n_poses, 6, replace=False):
+        c, t = poses % cells, int(target) % cells
+        h = (np.abs(c % width - t % width) + np.abs(c // width - t // width)) * cell_time \
+            + turn_time[int(target) // cells, poses // cells]
+        exact = dijkstra(matrix.T.tocsr(), indices=int(target))
+        assert h[target] == 0 and (h <= exact + 1e-12).all()
+        assert (h[tails] <= matrix.data + h[matrix.indices] + 1e-12).all()  # consistent along every edge
+
+
+def test_the_static_search_is_deterministic_and_leaves_its_arrays_as_it_found_them():
+    sim = Simulator(load_scenario("three_slit").workspace, commands=SEED000_COMMANDS)
+    graph = TransitionGraph(sim)
+    questions = static_questions(sim, np.random.default_rng(9), 30)
+    first = [graph._static_search(s, t, limit) for s, t, limit in questions]  # not remembered: searched
+    again = [graph._static_search(s, t, limit) for s, t, limit in reversed(questions)][::-1]
+    fresh = [TransitionGraph(sim).fastest(s, 0, t, 0, limit=limit) for s, t, limit in questions]
+    for a, b, c in zip(first, again, fresh):
+        assert [(p.tolist(), time) for p, time in a] == [(p.tolist(), time) for p, time in b] \
+            == [(p.tolist(), time) for p, time in c]
+    assert sum(map(len, first)) >= 10
+    arrays = graph._search_arrays()
+    assert np.isinf(arrays["best"]).all() and (arrays["position"] == -1).all()
+
+
+def test_the_compiled_static_search_gives_what_its_python_version_gives():
+    sim = Simulator(cluttered(3))
+    graph = TransitionGraph(sim)
+    answered = 0
+    for source, target, limit in static_questions(sim, np.random.default_rng(2), 12):
+        answers = []
+        for search in (_astar, _astar.py_func):
+            time, count = search(*graph._astar_arguments(source, target, limit))
+            answers.append((time, graph._search_arrays()["path"][:count].tolist()))
+        assert answers[0] == answers[1]
+        answered += np.isfinite(answers[0][0])
+    assert answered
+
+
+def test_of_equally_fast_paths_the_static_search_takes_one_with_few_command_changes():
+    # on an open map every monotone staircase between two O poses is as fast: the one found is an L
+    # (one change when both coordinates differ, none when one does), the fewest possible
+    sim = Simulator(Workspace(bordered(14, 14)))
+    graph = TransitionGraph(sim)
+    rng = np.random.default_rng(0)
+    for _ in range(100):
+        a, b = (Pose(int(rng.integers(2, 12)), int(rng.integers(2, 12)), "O", 0) for _ in range(2))
+        [(commands, time)] = graph.fastest(sim.encode(a), 0, sim.encode(b), 0, limit=100.0)
+        assert time == abs(a.x - b.x) + abs(a.y - b.y)
+        assert int((commands[1:] != commands[:-1]).sum()) == int(a.x != b.x and a.y != b.y)
