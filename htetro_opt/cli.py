@@ -51,7 +51,7 @@ __all__ = ["main", "main_entry", "build_parser"]
 EXIT_ERROR = 2
 GA_DEFAULTS = {"pop_size": 50, "max_gen": 1000, "patience": None, "converge": "best", "max_length": None, "seed": 0,
                "replan_window": None, "replan_members": None, "seed_exact": False, "pick": "balanced",
-               "reach_patience": None, "conservative": False}
+               "reach_patience": None, "polish_window": None, "conservative": False}
 """Defaults of ``plan``'s GA options (None in the parser, so that one given to an exact method is refused;
 None here: plan_ga's default for the algorithm)."""
 GA_PICKS = ("balanced", "fastest", "smoothest", "safest")  # htetro_opt.algorithms.PICKS, without loading pymoo
@@ -120,6 +120,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="htetro-ga: reach repair of ours, when no member has reached the goal and the best goal "
                         "reachability has not risen for N generations, the member nearest to the goal gets the "
                         "minimum-time path to it (default 100; off (0) in htetro-ga-paper)")
+    p.add_argument("--polish-window", type=int, metavar="W",
+                   help="htetro-ga: balanced polish of ours, when each leg's run ends the largest-sum leading-front "
+                        "member has windows of up to W commands of its path (the whole path when it has at most W) "
+                        "re-planned exactly for the largest fitness sum (default 40; off (0) in htetro-ga-paper)")
     p.add_argument("--conservative", action="store_true", default=None,
                    help="nsga2, nsga3, smsemoa, agemoea: add the hTetro-GA's conservative offspring set (removal, "
                         "rearrangement, shortcut of every member) to their mating, so that an algorithm swap compares "
@@ -421,7 +425,8 @@ _CONTINUOUS_FLAGS = {"path": "--path", "normalise": "--normalise", "safety": "--
                      "robot_radius": "--robot-radius", "time_limit": "--time-limit"}
 _GRID_FLAGS = {"patience": "--patience", "converge": "--converge", "max_length": "--max-length",
                "replan_window": "--replan-window", "replan_members": "--replan-members", "seed_exact": "--seed-exact",
-               "reach_patience": "--reach-patience", "conservative": "--conservative",
+               "reach_patience": "--reach-patience", "polish_window": "--polish-window",
+               "conservative": "--conservative",
                "pick": "--pick", "diagonals": "--diagonals", "t_max": "--t-max", "element": "--element",
                "no_monotone": "--no-monotone", "band": "--band", "sensor_range": "--sensor-range", "gif": "--gif"}
 
@@ -578,9 +583,12 @@ def _cmd_plan(args) -> dict:
                        max_length=check_int(args.max_length, "--max-length", minimum=1, allow_none=True),
                        seed=check_int(args.seed, "--seed", minimum=0),
                        seed_exact=bool(args.seed_exact), pick=args.pick)
-        for name in ("replan_window", "replan_members", "reach_patience"):  # None: the algorithm's default
+        for name in ("replan_window", "replan_members", "reach_patience", "polish_window"):  # None: the default
             if getattr(args, name) is not None:
                 options[name] = check_int(getattr(args, name), "--" + name.replace("_", "-"), minimum=0)
+        if options.get("polish_window") and not args.method.startswith("htetro-ga"):
+            raise ParameterError(f"--polish-window applies to the hTetro-GA (htetro-ga, htetro-ga-paper), not to "
+                                 f"--method {args.method}")
         if args.conservative:
             if args.method.startswith("htetro-ga"):
                 raise ParameterError(f"--conservative applies to pymoo's algorithms (nsga2, nsga3, smsemoa, agemoea), "

@@ -132,13 +132,15 @@ def make_algorithm(
     conservative: bool | None = None,
     include: Sequence = (),
     reach_patience: int | None = None,
+    polish_window: int | None = None,
 ):
     """A pymoo algorithm over command chromosomes.
 
     Parameters
     ----------
     name : {"htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea"}
-        ``"htetro-ga"`` is :class:`HTetroGA` with our repair, shortcut, niching and re-planning, ``"htetro-ga-paper"``
+        ``"htetro-ga"`` is :class:`HTetroGA` with our repair, shortcut, niching, re-planning, reach repair
+        and balanced polish, ``"htetro-ga-paper"``
         :meth:`HTetroGA.as_published`; the others are pymoo's algorithms with the command sampling,
         single-point crossover (rate ``crossover_rate``), mutation, duplicate elimination and the
         repair (NSGA-III with Das–Dennis reference directions, about ``pop_size`` of them).
@@ -166,14 +168,20 @@ def make_algorithm(
         minimum-time path to it. None: the default (100 for ``"htetro-ga"``, off for
         ``"htetro-ga-paper"``); 0 turns it off. pymoo's algorithms have no such step: a value other
         than 0 is refused there.
+    polish_window : int, optional
+        The hTetro-GA's balanced polish when a run ends (:class:`HTetroGA`,
+        :func:`~htetro_opt.operators.commands.polish_sum`): W, the window of the largest-sum member's
+        path re-planned for the largest fitness sum. None: the default (40 for ``"htetro-ga"``, off for
+        ``"htetro-ga-paper"``); 0 turns it off. pymoo's algorithms have no such step: a value other
+        than 0 is refused there.
 
     Raises
     ------
     ParameterError
         If the name is unknown, ``pop_size`` is below 2, ``crossover_rate`` is not a probability, a
         sampling weight is negative, ``replan_window`` or ``replan_members`` is negative,
-        ``reach_share`` is not in (0, 1] or below 1 for one of pymoo's, ``reach_patience`` is negative
-        or positive for one of pymoo's, ``conservative`` is not a bool
+        ``reach_share`` is not in (0, 1] or below 1 for one of pymoo's, ``reach_patience`` or
+        ``polish_window`` is negative or positive for one of pymoo's, ``conservative`` is not a bool
         or is given for the hTetro-GA, or ``"agemoea"`` is asked for
         without numba installed (pymoo's AGE-MOEA needs it: the ``agemoea`` extra).
 
@@ -193,6 +201,8 @@ def make_algorithm(
         replan["reach_share"] = check_real(reach_share, "reach_share", minimum=0.0, maximum=1.0, include_minimum=False)
     if reach_patience is not None:
         replan["reach_patience"] = check_int(reach_patience, "reach_patience", minimum=0)
+    if polish_window is not None:
+        replan["polish_window"] = check_int(polish_window, "polish_window", minimum=0)
     if conservative is not None:
         conservative = check_bool(conservative, "conservative")
         if name in ("htetro-ga", "htetro-ga-paper"):
@@ -204,6 +214,8 @@ def make_algorithm(
         return HTetroGA.as_published(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate, **replan)
     if replan.pop("reach_patience", 0):
         raise ParameterError(f"reach_patience applies to the hTetro-GA (htetro-ga, htetro-ga-paper), not to {name!r}")
+    if replan.pop("polish_window", 0):
+        raise ParameterError(f"polish_window applies to the hTetro-GA (htetro-ga, htetro-ga-paper), not to {name!r}")
     if replan.get("reach_share", 1.0) < 1.0:
         raise ParameterError(f"reach_share applies to the hTetro-GA (htetro-ga, htetro-ga-paper), not to {name!r}")
     operators = dict(

@@ -32,8 +32,9 @@ on the first four maps of its Table 6). The options:
   methods); ``pop_size``, ``max_gen``, ``patience``, ``max_length``, ``convergence`` (``"best"`` or
   ``"hypervolume"``), ``pick`` (``"balanced"``, ``"fastest"``, ``"smoothest"``, ``"safest"``),
   ``seed_exact``, ``replan_window``, ``replan_members`` (the GAs; pymoo's algorithms re-plan only
-  when given a window), ``reach_share`` (the hTetro-GA's sort) and ``reach_patience`` (its reach
-  repair) (``htetro-ga`` and ``htetro-ga-paper`` only), ``conservative`` (pymoo's algorithms only; see
+  when given a window), ``reach_share`` (the hTetro-GA's sort), ``reach_patience`` (its reach
+  repair) and ``polish_window`` (its balanced polish) (``htetro-ga`` and ``htetro-ga-paper`` only),
+  ``conservative`` (pymoo's algorithms only; see
   :func:`~htetro_opt.solvers.grid_paths.plan_ga`); ``weights``
   (``[w_t, w_sm, w_sf]`` or ``"w_t,w_sm,w_sf"``), ``t_max``, ``element`` (``"q1"`` or ``"p0"``),
   ``monotone``, ``band`` (``"auto"``, ``"full"`` or a radius in cells) (the heat planner of
@@ -470,6 +471,7 @@ _OPTIONS: dict[str, dict[str, tuple[Callable, str | None]]] = {
         "replan_members": (lambda v, n: check_int(v, n, minimum=0), "ga"),
         "reach_share": (lambda v, n: check_real(v, n, minimum=0.0, maximum=1.0, include_minimum=False), _HTETRO_GA),
         "reach_patience": (lambda v, n: check_int(v, n, minimum=0), _HTETRO_GA),
+        "polish_window": (lambda v, n: check_int(v, n, minimum=0), _HTETRO_GA),
         "conservative": (check_bool, _PYMOO_GA),
         "weights": (_check_heat_weights, "heat"),
         "t_max": (lambda v, n: check_real(v, n, minimum=0.0, include_minimum=False), "heat"),
@@ -1230,8 +1232,8 @@ def run_trial(task: str, scenario: str, method: str, parameters: Mapping[str, An
     parameters : mapping
         The verb's options, as a study's method entry gives them (``plan``: clearance, diagonals,
         pop_size, max_gen, patience, max_length, convergence, pick, seed_exact, replan_window,
-        replan_members, reach_share, reach_patience, conservative, and the heat planner's weights, t_max, element,
-        monotone, band; ``tile``: shapes, overlap, shuffle, time_limit; ``sequence``: start,
+        replan_members, reach_share, reach_patience, polish_window, conservative, and the heat planner's weights,
+        t_max, element, monotone, band; ``tile``: shapes, overlap, shuffle, time_limit; ``sequence``: start,
         weights, time_limit, shapes; ``cover``: shapes, start, clearance, stripes, region_columns,
         budget, time_limit).
     seed : int or None

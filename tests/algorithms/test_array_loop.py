@@ -32,7 +32,8 @@ def digest(X, F) -> str:
 
 # Final populations (chromosomes and F, bit for bit) and evaluation counts of 60 generations at
 # n_pop 40, recorded with the Population-based loop before the array loop replaced it (the same
-# algorithm: these change only when the algorithm does, and then on purpose).
+# algorithm: these change only when the algorithm does, and then on purpose). The balanced polish, which
+# runs once after the last generation and is not part of the loop, is off here (tests/algorithms/test_polish_ga.py).
 RECORDED = {
     ("three_slit", "htetro-ga", 0): ("614c12a8a1e991bb", 3547),
     # recorded again when the re-planning's static search became an A* (the same optimum times, another
@@ -49,13 +50,13 @@ RECORDED = {
 @pytest.mark.parametrize("case", list(RECORDED), ids=["-".join(map(str, c)) for c in RECORDED])
 def test_a_fixed_seed_gives_the_population_the_population_based_loop_gave(case):
     name, method, seed = case
-    res = minimize(scenario_problem(name), make_algorithm(method, 40), ("n_gen", 60), seed=seed)
+    res = minimize(scenario_problem(name), make_algorithm(method, 40, polish_window=0), ("n_gen", 60), seed=seed)
     assert (digest(sequences(res.pop.get("X")), res.pop.get("F")), res.algorithm.evaluator.n_eval) == RECORDED[case]
 
 
 def test_the_static_only_replan_step_still_gives_the_population_based_loops_run():
     # The record of the loop before the time-expanded re-planning search became the default.
-    algorithm = make_algorithm("htetro-ga", 40)
+    algorithm = make_algorithm("htetro-ga", 40, polish_window=0)
     algorithm.replan.timed = False
     res = minimize(scenario_problem("parallel_dynamic"), algorithm, ("n_gen", 60), seed=0)
     assert (digest(sequences(res.pop.get("X")), res.pop.get("F")), res.algorithm.evaluator.n_eval) == \

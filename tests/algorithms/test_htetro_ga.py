@@ -41,9 +41,9 @@ def population_arrays(res):
 
 def frozen(**options):
     """An hTetro-GA whose variation operators are never applied (pymoo ``prob`` 0) although each would
-    change every gene it is applied to (rate 1), and with neither repair nor shortcut (nor re-planning,
-    unless ``replan_window`` says)."""
-    options = {"replan_window": 0, **options}
+    change every gene it is applied to (rate 1), and with neither repair nor shortcut (nor re-planning
+    nor the balanced polish, unless ``replan_window`` or ``polish_window`` says)."""
+    options = {"replan_window": 0, "polish_window": 0, **options}
     return HTetroGA(pop_size=10, removal=CommandRemoval(1.0, 1.0, prob=0.0),
                     rearrangement=CommandRearrangement(1.0, prob=0.0), mutation=CommandMutation(1.0, prob=0.0),
                     crossover_rate=0.0, repair=False, shortcut=False, **options)
@@ -217,8 +217,8 @@ def test_replanning_keeps_the_run_reproducible_and_leaves_the_paper_variant_alon
     b = minimize(problem, HTetroGA(pop_size=16, replan_window=8), ("n_gen", 8), seed=2)
     assert population_arrays(a)[1] == population_arrays(b)[1]
     paper = minimize(problem, HTetroGA.as_published(16), ("n_gen", 8), seed=2)
-    off = minimize(problem, HTetroGA(16, repair=False, shortcut=False, niche_size=0, replan_window=0), ("n_gen", 8),
-                   seed=2)
+    off = minimize(problem, HTetroGA(16, repair=False, shortcut=False, niche_size=0, replan_window=0, polish_window=0),
+                   ("n_gen", 8), seed=2)
     assert population_arrays(paper)[1] == population_arrays(off)[1]
 
 

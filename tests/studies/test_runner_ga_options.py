@@ -10,7 +10,7 @@ from htetro_opt.studies.runner import Study, StudyError, load_study, run_study, 
 
 TINY = {"pop_size": 16, "max_gen": 100, "patience": 10}  # reaches the goal of h_shape and random with seeds 0 and 2
 OPTIONS = {"replan_window": 12, "replan_members": 1, "seed_exact": False, "pick": "fastest",
-           "convergence": "hypervolume", "reach_share": 0.75}
+           "convergence": "hypervolume", "reach_share": 0.75, "polish_window": 0}
 
 
 def _study(**entry):

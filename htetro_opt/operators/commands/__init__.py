@@ -13,6 +13,8 @@ takes the ``random_state`` pymoo passes:
 - :mod:`.replan`: ours, optional: replace a window of a path by the minimum-time path between its
   ends (:class:`CommandReplan`), or the tail of a path that misses the goal by the fastest way to
   it (:class:`CommandReachRepair`);
+- :mod:`.polish`: ours, optional: windows of a goal-reaching path re-planned for the largest fitness
+  sum (:func:`polish_sum`, the hTetro-GA's balanced polish when a run ends);
 - :mod:`.duplicates`: :class:`CommandDuplicateElimination`;
 - :mod:`.selection`: the size-4 deterministic tournament on rank and crowding;
 - :mod:`.survival`: the goal-reachability sort (:class:`GoalReachabilitySurvival`).
@@ -24,6 +26,7 @@ from htetro_opt.operators.commands.duplicates import CommandDuplicateElimination
 from htetro_opt.operators.commands.mutation import CommandMutation, mutate_commands
 from htetro_opt.operators.commands.rearrangement import CommandRearrangement, rearrange_commands
 from htetro_opt.operators.commands.repair import CommandRepair
+from htetro_opt.operators.commands.polish import fitness_sum, polish_sum
 from htetro_opt.operators.commands.removal import CommandRemoval, remove_commands
 from htetro_opt.operators.commands.replan import (
     CommandReachRepair,
@@ -51,6 +54,7 @@ __all__ = [
     "CommandMutation", "mutate_commands",
     "CommandRearrangement", "rearrange_commands",
     "CommandRemoval", "remove_commands",
+    "polish_sum", "fitness_sum",
     "CommandRepair",
     "CommandShortcut", "cut_longest_loop", "longest_loops", "shortcut_sequences", "repair_and_shortcut",
     "CommandReplan", "TransitionGraph", "replan_rows", "replan_windows", "CommandReachRepair", "reach_repair",

@@ -48,13 +48,14 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from htetro_opt._jit import lazy_jit
 from htetro_opt._validation import check_int
 from htetro_opt.errors import PlanningError
 from htetro_opt.model.commands import SEED000_COMMANDS, Timing
 from htetro_opt.model.robot import Pose, as_pose
 from htetro_opt.model.simulate import Simulator, check_memory, size_text
 from htetro_opt.model.workspace import Workspace
+# The programme's kernels live among the operators: the hTetro-GA's balanced polish solves it over windows.
+from htetro_opt.operators.commands._sum_dp import first_arrivals, min_bracket, usable_table
 from htetro_opt.problems.command_path import (
     FITNESS_NAMES,
     SAFETY_COEFFICIENT,
@@ -70,120 +71,6 @@ MAX_FITNESS_SUM_METHOD = "max-fitness-sum"
 """The ``method`` of the plans :func:`plan_max_fitness_sum` returns."""
 
 _SUM_TOLERANCE = 1e-9  # the DP's and the problem's float sums of the same plan differ in the last bits
-
-
-@lazy_jit  # compiled on first use: importing the planner does not import numba
-def _first_arrivals(target, usable, phase0, start, goal, arrivals):
-    """``arrivals[l]`` = whether some valid sequence of exactly l commands first reaches ``goal`` at
-    its l-th command (``arrivals[0]`` stays False): a forward reachability pass over the layers, the
-    goal never expanded (a child stops there)."""
-    n_poses, n_commands = target.shape
-    period = usable.shape[0]
-    here = np.zeros(n_poses, dtype=np.bool_)
-    after = np.zeros(n_poses, dtype=np.bool_)
-    here[start] = True
-    for k in range(1, len(arrivals)):
-        phase = (phase0 + k - 1) % period
-        after[:] = False
-        any_live = False
-        for p in range(n_poses):
-            if not here[p]:
-                continue
-            for c in range(n_commands):
-                if usable[phase, p, c]:
-                    q = target[p, c]
-                    if q == goal:
-                        arrivals[k] = True
-                    else:
-                        after[q] = True
-                        any_live = True
-        here, after = after, here
-        if not any_live:
-            break
-
-
-@lazy_jit
-def _min_bracket(target, usable, phase0, durations, danger, start, goal, length, w_time, w_change, w_danger,
-                 value, scratch, active, touched, stamp, parents, keep_parents):
-    """The least bracket (see the module docstring) over the valid sequences of exactly ``length``
-    commands that first reach ``goal`` at the last one, and the last command of the best (−1 and
-    ``inf`` when there is none).
-
-    ``value``/``scratch`` (poses × commands, float) hold V of the current and the next layer,
-    ``active``/``touched`` (poses, int) the poses of finite V in them, ``stamp`` (poses, int) marks
-    a pose as touched in a layer. With ``keep_parents``, ``parents[k − 1, p′, c′]`` is
-    ``p * n_commands + c`` of the best predecessor of (p′, c′) in layer k (−1 in layer 1).
-    """
-    n_commands = target.shape[1]
-    period = usable.shape[0]
-    inf = np.inf
-    value[:] = inf
-    stamp[:] = 0
-    n_active = 1
-    active[0] = start
-    for k in range(1, length + 1):
-        phase = (phase0 + k - 1) % period
-        last = k == length
-        scratch[:] = inf
-        n_touched = 0
-        for i in range(n_active):
-            p = active[i]
-            if k == 1:
-                best_here, best_command = 0.0, -1
-            else:
-                best_here, best_command = inf, -1
-                for c in range(n_commands):
-                    if value[p, c] < best_here:
-                        best_here, best_command = value[p, c], c
-                if best_here == inf:
-                    continue
-            switched = best_here + w_change
-            for c in range(n_commands):
-                if not usable[phase, p, c]:
-                    continue
-                q = target[p, c]
-                if (q == goal) != last:  # the goal only at the last command: a child stops there
-                    continue
-                if k == 1:
-                    base, previous = 0.0, -1
-                elif value[p, c] <= switched:  # keeping the command beats the best change (inf never does)
-                    base, previous = value[p, c], c
-                else:
-                    base, previous = switched, best_command
-                candidate = base + w_time * durations[c] + w_danger * danger[q]
-                if candidate < scratch[q, c]:
-                    scratch[q, c] = candidate
-                    if keep_parents:
-                        parents[k - 1, q, c] = -1 if previous < 0 else p * n_commands + previous
-                    if stamp[q] != k:
-                        stamp[q] = k
-                        touched[n_touched] = q
-                        n_touched += 1
-        if n_touched == 0:
-            return inf, -1
-        value, scratch = scratch, value
-        active, touched = touched, active
-        n_active = n_touched
-    best, best_command = inf, -1
-    for c in range(n_commands):
-        if value[goal, c] < best:
-            best, best_command = value[goal, c], c
-    return best, best_command
-
-
-def _usable(sim: Simulator) -> np.ndarray:
-    """``usable[phase, pose, command]``: the command is valid from the pose when it is executed at a
-    clock of that phase of the moving obstacles' period (one phase on a static map): the simulator's
-    table and its blocked keys, as :meth:`~htetro_opt.model.Simulator.run` checks them."""
-    n, c = sim.n_poses, sim.n_commands
-    static = sim.next[:n, :c] != sim.dead
-    if not sim.workspace.moving:
-        return static[None]
-    usable = np.repeat(static[None], sim.workspace.period, axis=0)
-    for phase in range(sim.workspace.period):
-        keys = sim.blocked_keys(phase)
-        usable[phase, keys // sim.n_columns, keys % sim.n_columns] = False
-    return usable
 
 
 def _parents_bytes(length: int, sim: Simulator) -> int:
@@ -300,14 +187,15 @@ def plan_max_fitness_sum(
     cap = closes_by if max_commands is None else min(max_commands, closes_by)
 
     target = np.ascontiguousarray(sim.next[: sim.n_poses, : sim.n_commands])
-    usable = _usable(sim)
+    usable = usable_table(sim)
     phase0 = t0 % period
     danger = np.ascontiguousarray(problem._pose_danger[: sim.n_poses])
     arrivals = np.zeros(cap + 1, dtype=np.bool_)
-    _first_arrivals(target, usable, phase0, start_id, goal_id, arrivals)
+    first_arrivals(target, usable, phase0, start_id, goal_id, arrivals)
     value, scratch = (np.empty((sim.n_poses, sim.n_commands)) for _ in range(2))
     active, touched, stamp = (np.zeros(sim.n_poses, dtype=np.int64) for _ in range(3))
     no_parents = np.zeros((1, 1, 1), dtype=np.int32)
+    no_pruning = np.zeros(sim.n_poses, dtype=np.int64)  # every pose may still reach the goal in the layers left
 
     def weights(length: int) -> tuple[float, float, float]:
         return 1.0 / t_max, (1.0 / (length - 1) if length > 1 else 0.0), 1.0 / (length * SAFETY_COEFFICIENT)
@@ -325,8 +213,9 @@ def plan_max_fitness_sum(
                                 f"{4.0 - length * shortest / t_max:.6f}): raise max_commands")
         if not arrivals[length]:
             continue
-        bracket, _ = _min_bracket(target, usable, phase0, durations, danger, start_id, goal_id, length,
-                                  *weights(length), value, scratch, active, touched, stamp, no_parents, False)
+        bracket, _ = min_bracket(target, usable, phase0, durations, danger, start_id, -1, goal_id, -1, goal_id,
+                                 length, *weights(length), no_pruning, value, scratch, active, touched, stamp,
+                                 no_parents, False)
         if 4.0 - bracket > best_sum:  # strictly: of equal sums, the fewest commands
             best_sum, best_length = 4.0 - bracket, length
     info["lengths_searched"] = length - 1
@@ -336,8 +225,9 @@ def plan_max_fitness_sum(
                  f"{size_text(_parents_bytes(best_length, sim))})", "use a smaller map or coarser cells")
     parents = np.full((best_length, sim.n_poses, sim.n_commands), -1, dtype=np.int32 if
                       sim.n_poses * sim.n_commands < 2**31 else np.int64)
-    bracket, command = _min_bracket(target, usable, phase0, durations, danger, start_id, goal_id, best_length,
-                                    *weights(best_length), value, scratch, active, touched, stamp, parents, True)
+    bracket, command = min_bracket(target, usable, phase0, durations, danger, start_id, -1, goal_id, -1, goal_id,
+                                   best_length, *weights(best_length), no_pruning, value, scratch, active, touched,
+                                   stamp, parents, True)
     local = [command]
     pose = goal_id
     for k in range(best_length - 1, 0, -1):  # walk the back pointers from the goal's last command

@@ -147,6 +147,7 @@ def plan_ga(
     reach_share: float | None = None,
     conservative: bool | None = None,
     reach_patience: int | None = None,
+    polish_window: int | None = None,
 ) -> Plan:
     """Plan through a roadmap with a command-chromosome GA, one optimisation per leg.
 
@@ -230,6 +231,13 @@ def plan_ga(
         minimum-time path from there (:func:`~htetro_opt.operators.commands.reach_repair`). None: the
         algorithm's default, 100 for ``"htetro-ga"``, off for ``"htetro-ga-paper"``; 0 turns it off.
         Refused (unless 0) for pymoo's algorithms.
+    polish_window : int, optional, keyword-only
+        The hTetro-GA's balanced polish (ours; :class:`~htetro_opt.algorithms.HTetroGA`): when a leg's
+        run ends, the leading-front member with the largest fitness sum (the ``"balanced"`` pick) has
+        windows of up to this many commands of its path re-planned exactly for the largest sum, the
+        whole path when it is no longer (:func:`~htetro_opt.operators.commands.polish_sum`). None: the
+        algorithm's default, 40 for ``"htetro-ga"``, off for ``"htetro-ga-paper"``; 0 turns it off.
+        Refused (unless 0) for pymoo's algorithms.
 
     Returns
     -------
@@ -257,7 +265,8 @@ def plan_ga(
     (True, 7.0)
     """
     make_algorithm(algorithm, pop_size, replan_window=replan_window, replan_members=replan_members,
-                   reach_share=reach_share, conservative=conservative, reach_patience=reach_patience)  # validates
+                   reach_share=reach_share, conservative=conservative, reach_patience=reach_patience,
+                   polish_window=polish_window)  # validates
     seed_exact = check_bool(seed_exact, "seed_exact")
     if not isinstance(pick, str) or pick not in PICKS:
         raise ParameterError(f"pick must be one of {', '.join(PICKS)}, got {pick!r}")
@@ -296,7 +305,8 @@ def plan_ga(
         res = minimize(problem, make_algorithm(algorithm, pop_size, sampling_weights=sampling_weights,
                                                replan_window=replan_window, replan_members=replan_members,
                                                reach_share=reach_share, conservative=conservative,
-                                               include=include, reach_patience=reach_patience),
+                                               include=include, reach_patience=reach_patience,
+                                               polish_window=polish_window),
                        termination, seed=int(leg_seeds[leg]), callback=recorder, verbose=verbose)
         X, F = res.pop.get("X"), res.pop.get("F")
         chosen = select_solutions(F)
