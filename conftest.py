@@ -14,3 +14,12 @@ from hypothesis import settings  # noqa: E402
 settings.register_profile("ci", derandomize=True, database=None)
 settings.register_profile("explore", derandomize=False)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
+
+# A shell that starts a job in the background (`cmd &` without job control, `nohup`) makes it ignore
+# SIGINT, and the processes it starts inherit that: the Ctrl-C tests would then see no interrupt at
+# all. The suite restores Python's own handler, so that those tests check the library, not how the
+# run was launched (child processes then start with SIGINT's default action, as from a terminal).
+import signal  # noqa: E402
+
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
