@@ -59,7 +59,8 @@ from htetro_opt.scenarios import (
     scenario_path,
     tileset_path,
 )
-from htetro_opt.solvers.grid_paths import plan_exact, plan_ga, plan_path
+from htetro_opt.operators.commands import polish_sum
+from htetro_opt.solvers.grid_paths import plan_exact, plan_ga, plan_max_fitness_sum, plan_path
 from htetro_opt.solvers.sequencing import (
     double_bridge,
     held_karp,
@@ -168,6 +169,15 @@ CASES = [
     ("plan_exact diagonals", lambda: plan_exact(WS, ROADMAP, diagonals="no"), ParameterError, "diagonals"),
     ("plan_ga roadmap", lambda: plan_ga(WS, "abc"), ParameterError, "roadmap"),
     ("plan_ga workspace", lambda: plan_ga(3, ROADMAP), ParameterError, "workspace"),
+    ("plan_max_fitness_sum workspace", lambda: plan_max_fitness_sum("abc", START, GOAL), ParameterError, "workspace"),
+    ("plan_max_fitness_sum start", lambda: plan_max_fitness_sum(WS, "abc", GOAL), ConfigurationError, "start"),
+    ("plan_max_fitness_sum max_length", lambda: plan_max_fitness_sum(WS, START, GOAL, max_length="x"),
+     ParameterError, "max_length"),
+    ("polish_sum problem", lambda: polish_sum("abc", [1]), ParameterError, "problem"),
+    ("polish_sum sequence", lambda: polish_sum(CommandPathProblem(WS, START, GOAL, max_length=5), "abc"),
+     ParameterError, "sequence"),
+    ("polish_sum window", lambda: polish_sum(CommandPathProblem(WS, START, GOAL, max_length=5), [1], window="x"),
+     ParameterError, "polish_window"),
     ("tile_workspace", lambda: tile_workspace("abc"), ParameterError, "workspace"),
     ("tile_workspace name", lambda: tile_workspace(np.zeros((2, 2), bool), name=5), ParameterError, "name"),
     ("find_tiles", lambda: find_tiles(None), ParameterError, "occupancy"),

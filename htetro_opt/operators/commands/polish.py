@@ -213,7 +213,8 @@ def polish_sum(problem: CommandPathProblem, sequence, *, window: int = POLISH_WI
     ------
     ParameterError
         If ``window``, ``span`` or ``max_rounds`` is not a non-negative integer (``max_rounds`` at
-        least 1), or ``problem`` is not a CommandPathProblem.
+        least 1), ``problem`` is not a CommandPathProblem, or ``sequence`` is not an array of the
+        problem's command ids.
 
     Examples
     --------
@@ -232,7 +233,13 @@ def polish_sum(problem: CommandPathProblem, sequence, *, window: int = POLISH_WI
     span = check_int(span, "span", minimum=0, allow_none=True)
     max_rounds = check_int(max_rounds, "max_rounds", minimum=1)
     given = sequence
-    sequence = np.asarray(sequence, dtype=np.int64).ravel()
+    try:
+        sequence = np.asarray(sequence, dtype=np.int64).ravel()
+    except (TypeError, ValueError):
+        raise ParameterError(f"sequence must be an array of global command ids, got {sequence!r}") from None
+    if not np.isin(sequence, problem.command_ids).all():
+        raise ParameterError(f"sequence holds ids outside the problem's command alphabet: "
+                             f"{sorted(set(sequence[~np.isin(sequence, problem.command_ids)].tolist()))[:5]}")
     result = problem.simulate([sequence])
     if not window or not result.reached[0] or result.executed[0] == 0:
         return given
