@@ -34,7 +34,7 @@ from htetro_opt.operators.commands import (
     replan_windows,
     sequences,
 )
-from htetro_opt.operators.commands.replan import _astar
+from htetro_opt.operators.commands.replan import _astar, _pop, _sift_up
 from htetro_opt.problems import CommandPathProblem
 from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers.grid_paths import plan_exact
@@ -500,3 +500,43 @@ def test_of_equally_fast_paths_the_static_search_takes_one_with_few_command_chan
         [(commands, time)] = graph.fastest(sim.encode(a), 0, sim.encode(b), 0, limit=100.0)
         assert time == abs(a.x - b.x) + abs(a.y - b.y)
         assert int((commands[1:] != commands[:-1]).sum()) == int(a.x != b.x and a.y != b.y)
+
+
+def test_the_static_searchs_heap_pops_in_the_order_of_its_keys():
+    # oracle: Python's sort by (time + heuristic, changes, -time, pose); keys drawn from a few values so
+    # that most comparisons tie on the first ones, some keys lowered in place, a few poses popped and
+    # pushed again (as the search does when a label improves after its expansion)
+    rng = np.random.default_rng(5)
+    n = 300
+    heap, position = np.empty(n, dtype=np.int64), np.full(n, -1, dtype=np.int64)
+    heap_key, heap_changes, heap_time = np.empty(n), np.empty(n, dtype=np.int64), np.empty(n)
+    keys, size, popped, again = {}, 0, [], 0
+
+    def push(node, key):
+        nonlocal size
+        keys[node] = key
+        if position[node] < 0:
+            size += 1
+            _sift_up(heap, heap_key, heap_changes, heap_time, position, size - 1, node, *key)
+        else:
+            _sift_up(heap, heap_key, heap_changes, heap_time, position, int(position[node]), node, *key)
+
+    def order(node):
+        key, changes, time = keys[node]
+        return key, changes, -time, node
+
+    for node in rng.permutation(n)[:200]:
+        push(int(node), (float(rng.integers(20, 24)), int(rng.integers(0, 4)), float(rng.integers(0, 6))))
+    for node in [m for m in keys if rng.random() < 0.3]:  # lowered in place: a smaller time + heuristic
+        key, changes, time = keys[node]
+        push(node, (key - 1.0, changes, time))
+    while size:
+        assert heap[0] == min(keys, key=order)
+        node = int(heap[0])
+        size = _pop(heap, heap_key, heap_changes, heap_time, position, size)
+        popped.append(node)
+        del keys[node]
+        if len(popped) % 40 == 0:
+            push(node, (19.0, 0, 0.0))  # back on the heap, now first
+            again += 1
+    assert (position == -1).all() and len(popped) == 200 + again and again >= 4
