@@ -71,17 +71,20 @@ def min_bracket(target, usable, phase0, durations, danger, start, start_command,
     first arrival). ``steps_to_end[q]`` is a lower bound on the commands from pose q to ``end``: a
     pose that cannot reach ``end`` in the layers left is not expanded (all zeros: no pruning).
 
-    ``value``/``scratch`` (poses × commands, float) hold V of the current and the next layer,
-    ``active``/``touched`` (poses, int) the poses of finite V in them, ``stamp`` (poses, int) marks
-    a pose as touched in a layer. With ``keep_parents``, ``parents[k − 1, p′, c′]`` is
-    ``p * n_commands + c`` of the best predecessor of (p′, c′) in layer k (−1 in layer 1).
+    ``value``/``scratch`` (poses × commands, float) hold V of the current and the next layer; they
+    must be all ``inf`` on entry and are left so (only the rows of the poses a layer touches are
+    reset, not the whole tables: on a 128 × 128 map a table is 48 MB and a layer touches a few
+    thousand poses). ``active``/``touched`` (poses, int) hold the poses of finite V in them,
+    ``stamp`` (poses, int) marks a pose as touched in a layer. With ``keep_parents``, ``parents[k − 1, p′, c′]`` is
+    ``p * n_commands + c`` of the best predecessor of (p′, c′) in layer k (−1 in layer 1), written
+    wherever V is, so that ``parents`` need not be initialised: a walk back from a finite V reads
+    only entries this call wrote.
     For the inner minimum over the previous command, see the exact maximiser's module docstring:
     per pose, keeping its own command or changing from the pose's best is all that needs comparing.
     """
     n_commands = target.shape[1]
     period = usable.shape[0]
     inf = np.inf
-    value[:] = inf
     stamp[:] = 0
     n_active = 1
     active[0] = start
@@ -89,7 +92,6 @@ def min_bracket(target, usable, phase0, durations, danger, start, start_command,
         phase = (phase0 + k - 1) % period
         last = k == length
         left = length - k  # commands still to come after layer k
-        scratch[:] = inf
         n_touched = 0
         for i in range(n_active):
             p = active[i]
@@ -128,6 +130,8 @@ def min_bracket(target, usable, phase0, durations, danger, start, start_command,
                         stamp[q] = k
                         touched[n_touched] = q
                         n_touched += 1
+        for i in range(n_active):  # V of layer k − 1 is spent: its rows back to inf for layer k + 1
+            value[active[i], :] = inf
         if n_touched == 0:
             return inf, -1
         value, scratch = scratch, value
@@ -140,6 +144,8 @@ def min_bracket(target, usable, phase0, durations, danger, start, start_command,
             closing += w_change
         if closing < best:
             best, best_command = closing, c
+    for i in range(n_active):  # leave both tables all inf for the next call
+        value[active[i], :] = inf
     return best, best_command
 
 

@@ -92,7 +92,7 @@ class _Leg:
         self.danger = np.ascontiguousarray(problem._pose_danger[: sim.n_poses])
         self.indptr, self.indices = reverse_graph(self.target, self.usable)
         self.steps = np.empty(sim.n_poses, dtype=np.int64)
-        self.value, self.scratch = (np.empty((sim.n_poses, sim.n_commands)) for _ in range(2))
+        self.value, self.scratch = (np.full((sim.n_poses, sim.n_commands), np.inf) for _ in range(2))  # kept inf
         self.active, self.touched, self.stamp = (np.zeros(sim.n_poses, dtype=np.int64) for _ in range(3))
         self.no_parents = np.zeros((1, 1, 1), dtype=np.int32)
         self.layer_bytes = sim.n_poses * sim.n_commands * 4
@@ -112,7 +112,9 @@ class _Leg:
 
     def window_commands(self, start, start_command, end, end_command, phase0, m, total_length) -> np.ndarray:
         """The best m local commands of the window (the programme with back pointers)."""
-        parents = np.full((m, self.sim.n_poses, self.sim.n_commands), -1, dtype=np.int32)
+        # not initialised: the programme writes a back pointer wherever it sets a value, and the walk
+        # reads only those (the untouched pages of an empty array are never allocated)
+        parents = np.empty((m, self.sim.n_poses, self.sim.n_commands), dtype=np.int32)
         _, command = self.solve(start, start_command, end, end_command, phase0, m, total_length, parents)
         local, pose = [command], end
         for k in range(m - 1, 0, -1):  # walk the back pointers from the window's last command

@@ -192,7 +192,7 @@ def plan_max_fitness_sum(
     danger = np.ascontiguousarray(problem._pose_danger[: sim.n_poses])
     arrivals = np.zeros(cap + 1, dtype=np.bool_)
     first_arrivals(target, usable, phase0, start_id, goal_id, arrivals)
-    value, scratch = (np.empty((sim.n_poses, sim.n_commands)) for _ in range(2))
+    value, scratch = (np.full((sim.n_poses, sim.n_commands), np.inf) for _ in range(2))  # min_bracket keeps them inf
     active, touched, stamp = (np.zeros(sim.n_poses, dtype=np.int64) for _ in range(3))
     no_parents = np.zeros((1, 1, 1), dtype=np.int32)
     no_pruning = np.zeros(sim.n_poses, dtype=np.int64)  # every pose may still reach the goal in the layers left
@@ -223,8 +223,10 @@ def plan_max_fitness_sum(
     check_memory(_parents_bytes(best_length, sim) + work_bytes,
                  f"the fitness-sum search's back pointers ({best_length} layers of {sim.n_poses} poses; "
                  f"{size_text(_parents_bytes(best_length, sim))})", "use a smaller map or coarser cells")
-    parents = np.full((best_length, sim.n_poses, sim.n_commands), -1, dtype=np.int32 if
-                      sim.n_poses * sim.n_commands < 2**31 else np.int64)
+    # not initialised: min_bracket writes a back pointer wherever it sets a value, and the walk below
+    # reads only those (untouched pages of an empty array cost no memory)
+    parents = np.empty((best_length, sim.n_poses, sim.n_commands), dtype=np.int32 if
+                       sim.n_poses * sim.n_commands < 2**31 else np.int64)
     bracket, command = min_bracket(target, usable, phase0, durations, danger, start_id, -1, goal_id, -1, goal_id,
                                    best_length, *weights(best_length), no_pruning, value, scratch, active, touched,
                                    stamp, parents, True)
