@@ -155,3 +155,43 @@ def test_the_exact_maximiser_uses_the_shared_programme():
     from htetro_opt.solvers.grid_paths import _fitness_sum
 
     assert _fitness_sum.min_bracket is _sum_dp.min_bracket and _fitness_sum.first_arrivals is _sum_dp.first_arrivals
+
+
+def test_the_programme_leaves_its_tables_as_it_found_them():
+    """min_bracket resets only the rows it touched: on shared tables, a sequence of questions gets the
+    answers each gets on fresh tables, and the tables end all inf (the contract of both callers)."""
+    from htetro_opt.operators.commands._sum_dp import backward_steps, min_bracket, reverse_graph, usable_table
+
+    scenario = load_scenario("h_shape")
+    problem = CommandPathProblem(scenario.workspace, scenario.start, scenario.goal, max_length=100)
+    sim = problem.simulator
+    n, c = sim.n_poses, sim.n_commands
+    target = np.ascontiguousarray(sim.next[:n, :c])
+    usable = usable_table(sim)
+    durations = np.ascontiguousarray(sim.durations[:c], dtype=np.float64)
+    danger = np.ascontiguousarray(problem._pose_danger[:n])
+    indptr, indices = reverse_graph(target, usable)
+    exact = plan_exact(sim, [problem.start, problem.goal])
+    run = problem.simulate([exact.commands])
+    poses = (run.keys[: len(exact.commands) + 1, 0] // sim.n_columns).tolist()  # pose ids along the optimum
+
+    def tables():
+        return (np.full((n, c), np.inf), np.full((n, c), np.inf), np.zeros(n, dtype=np.int64),
+                np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64))
+
+    shared = tables()
+    rng = np.random.default_rng(3)
+    answered = 0
+    for _ in range(12):
+        i = int(rng.integers(0, len(poses) - 6))
+        j = i + int(rng.integers(2, 6))
+        steps = np.empty(n, dtype=np.int64)
+        backward_steps(indptr, indices, poses[j], problem.goal_id, steps)
+        m = j - i + int(rng.integers(0, 3))
+        arguments = (target, usable, 0, durations, danger, poses[i], -1, poses[j], -1, problem.goal_id, m,
+                     0.01, 1.0 / 40, 1.0 / 400, steps)
+        fresh = min_bracket(*arguments, *tables(), np.zeros((1, 1, 1), dtype=np.int32), False)
+        assert min_bracket(*arguments, *shared, np.zeros((1, 1, 1), dtype=np.int32), False) == fresh
+        assert np.isinf(shared[0]).all() and np.isinf(shared[1]).all()
+        answered += bool(np.isfinite(fresh[0]))
+    assert answered >= 6  # most windows of the optimum have a way of m commands (m ≥ the window's own)
