@@ -10,6 +10,7 @@ from __future__ import annotations
 from math import comb
 from typing import Mapping, Sequence
 
+import numpy as np
 from pymoo.core.infill import InfillCriterion
 from pymoo.core.population import Population
 
@@ -234,6 +235,23 @@ def make_algorithm(
     return algorithm
 
 
+def _comp_by_cv_then_random(pop, P, random_state=None, **kwargs):
+    """pymoo's NSGA-III tournament (``comp_by_cv_then_random``) with the algorithm's generator passed
+    on: pymoo 0.6.2's draws the winner of two equally infeasible individuals from fresh entropy (its
+    ``compare`` is called without ``random_state``), so a constrained problem (the path bases') gave
+    another front at every run of the same seed."""
+    from pymoo.operators.selection.tournament import compare
+
+    S = np.full(P.shape[0], -1, dtype=int)
+    for i, (a, b) in enumerate(P[:, :2]):
+        if pop[a].CV > 0.0 or pop[b].CV > 0.0:  # the less infeasible, or a random one of two equal
+            S[i] = compare(a, pop[a].CV, b, pop[b].CV, method="smaller_is_better", return_random_if_equal=True,
+                           random_state=random_state)
+        else:  # both feasible: a random one, as pymoo's
+            S[i] = random_state.choice([a, b])
+    return S[:, None]
+
+
 def _pymoo_algorithm(name: str, pop_size: int, operators: dict, *, n_objectives: int = 4):
     """pymoo's ``name`` (nsga2, nsga3, smsemoa, agemoea) over the given operators; NSGA-III's Das–Dennis
     directions are the most, for ``n_objectives``, that ``pop_size`` holds (at least one partition)."""
@@ -248,7 +266,10 @@ def _pymoo_algorithm(name: str, pop_size: int, operators: dict, *, n_objectives:
         partitions = 1
         while _n_directions(n_objectives, partitions + 1) <= pop_size:
             partitions += 1
+        from pymoo.operators.selection.tournament import TournamentSelection
+
         ref_dirs = get_reference_directions("das-dennis", n_objectives, n_partitions=partitions)
+        operators = {"selection": TournamentSelection(func_comp=_comp_by_cv_then_random), **operators}
         return NSGA3(ref_dirs=ref_dirs, pop_size=pop_size, **operators)
     if name == "smsemoa":
         from pymoo.algorithms.moo.sms import SMSEMOA
