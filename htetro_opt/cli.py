@@ -586,9 +586,10 @@ def _cmd_plan(args) -> dict:
         for name in ("replan_window", "replan_members", "reach_patience", "polish_window"):  # None: the default
             if getattr(args, name) is not None:
                 options[name] = check_int(getattr(args, name), "--" + name.replace("_", "-"), minimum=0)
-        if options.get("polish_window") and not args.method.startswith("htetro-ga"):
-            raise ParameterError(f"--polish-window applies to the hTetro-GA (htetro-ga, htetro-ga-paper), not to "
-                                 f"--method {args.method}")
+        for name in ("reach_patience", "polish_window"):  # the hTetro-GA's own steps, named by their flag
+            if options.get(name) and not args.method.startswith("htetro-ga"):
+                raise ParameterError(f"--{name.replace('_', '-')} applies to the hTetro-GA (htetro-ga, htetro-ga-paper), "
+                                     f"not to --method {args.method}")
         if args.conservative:
             if args.method.startswith("htetro-ga"):
                 raise ParameterError(f"--conservative applies to pymoo's algorithms (nsga2, nsga3, smsemoa, agemoea), "

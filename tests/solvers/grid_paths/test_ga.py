@@ -221,6 +221,7 @@ def test_cli_ga_flags(capsys):
     (["--method", "htetro-ga", "--conservative"], "--conservative"),
     (["--method", "htetro-ga-paper", "--conservative"], "--conservative"),
     (["--method", "dijkstra", "--conservative"], "--conservative"),
+    (["--method", "nsga2", "--reach-patience", "5"], "--reach-patience"),
 ])
 def test_cli_bad_ga_flags_exit_2(capsys, argv, flag):
     code, out, err = cli(capsys, ["plan", "three_slit", *argv, "--quiet"])
