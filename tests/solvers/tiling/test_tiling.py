@@ -364,7 +364,7 @@ def test_the_sweep_stage_tiles_small_maps(small_sweep):
         occ = area_fixed(rng.random((8, 8)) < 0.1)
         try:
             assert_exact_cover(occ, find_tiles(occ))
-        except TilingError:
+        except TilingError:  # an untileable draw (proven so by the later stages): the sweep's count says enough
             pass
     assert sum(small_sweep) >= 5, small_sweep
 
