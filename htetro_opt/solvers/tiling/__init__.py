@@ -9,7 +9,10 @@ in steps, so that no map makes it search for long where another method would not
 within the time limit (:data:`DEFAULT_TIME_LIMIT`, 60 s, when none is given) its subclass
 :class:`TilingTimeLimitError`.
 
-Importing this package imports neither pymoo nor DEAP.
+Importing this package imports neither pymoo nor DEAP, nor OR-Tools or numba (CP-SAT and the
+compiled sweep import them when they run). The entry points live in ``_tiling``; each algorithm in
+its own private module (``_prechecks``, ``_backtracking``, ``_cpsat``, ``_portfolio`` with
+``_sweep``, ``_overlap``, and ``_common`` for what they share), described in its docstring.
 """
 
 from htetro_opt._lazy import attach
@@ -17,8 +20,4 @@ from htetro_opt._lazy import attach
 __getattr__, __dir__, __all__ = attach(__name__, {
     "tile_workspace": "._tiling", "enumerate_tilings": "._tiling", "find_tiles": "._tiling",
     "TILING_METHODS": "._tiling", "TilingTimeLimitError": "._tiling", "DEFAULT_TIME_LIMIT": "._tiling",
-    "AUTO_STEPS": "._tiling", "BAND_ROWS": "._tiling",
-    "BAND_COMMIT": "._tiling", "BAND_WORK": "._tiling", "SWEEP_CELLS": "._tiling", "SWEEP_POCKET": "._tiling",
-    "SWEEP_FINAL": "._tiling", "STRIP_LIFTS": "._tiling", "STRIP_STEPS": "._tiling", "REPAIR_BOXES": "._tiling",
-    "REPAIR_WORK": "._tiling", "REPAIR_TRIES": "._tiling",
 })

@@ -250,11 +250,12 @@ def test_auto_tiles_scattered_obstacles(h, w):
 @pytest.fixture
 def tiny_bands(monkeypatch):
     """Bands of 2 rows (1 kept) and no backtracking stage: the band stage runs on small maps."""
-    import htetro_opt.solvers.tiling._tiling as module
+    # private tuning constants (not API): set on the private module that reads them, to force a stage
+    import htetro_opt.solvers.tiling._portfolio as module
 
-    monkeypatch.setattr(module, "AUTO_STEPS", (0, 0))
-    monkeypatch.setattr(module, "BAND_ROWS", 2)
-    monkeypatch.setattr(module, "BAND_COMMIT", 1)
+    monkeypatch.setattr(module, "_AUTO_STEPS", (0, 0))
+    monkeypatch.setattr(module, "_BAND_ROWS", 2)
+    monkeypatch.setattr(module, "_BAND_COMMIT", 1)
 
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow,
@@ -324,13 +325,14 @@ def test_auto_is_reproducible_on_scattered_maps():
 def small_sweep(monkeypatch):
     """No backtracking stage and the sweep on small maps, with small repair boxes and final strip,
     and a record of the tilings the sweep returned (a test that never saw one would prove nothing)."""
-    import htetro_opt.solvers.tiling._tiling as module
+    # private tuning constants (not API): set on the private module that reads them, to force a stage
+    import htetro_opt.solvers.tiling._portfolio as module
 
-    monkeypatch.setattr(module, "AUTO_STEPS", (0, 0))
-    monkeypatch.setattr(module, "SWEEP_CELLS", 0)
-    monkeypatch.setattr(module, "SWEEP_FINAL", 2)
-    monkeypatch.setattr(module, "STRIP_LIFTS", (0, 1, 3))
-    monkeypatch.setattr(module, "REPAIR_BOXES", ((1, 2), (2, 3)))
+    monkeypatch.setattr(module, "_AUTO_STEPS", (0, 0))
+    monkeypatch.setattr(module, "_SWEEP_CELLS", 0)
+    monkeypatch.setattr(module, "_SWEEP_FINAL", 2)
+    monkeypatch.setattr(module, "_STRIP_LIFTS", (0, 1, 3))
+    monkeypatch.setattr(module, "_REPAIR_BOXES", ((1, 2), (2, 3)))
     swept = []
     sweep_tiling = module._sweep_tiling
 
@@ -372,10 +374,11 @@ def test_the_sweep_stage_tiles_small_maps(small_sweep):
 @pytest.fixture
 def regions_only(monkeypatch):
     """No backtracking stage and no sweep: CP-SAT region by region decides (maps too small for bands)."""
-    import htetro_opt.solvers.tiling._tiling as module
+    # private tuning constants (not API): set on the private module that reads them, to force a stage
+    import htetro_opt.solvers.tiling._portfolio as module
 
-    monkeypatch.setattr(module, "AUTO_STEPS", (0, 0))
-    monkeypatch.setattr(module, "SWEEP_CELLS", 10 ** 9)
+    monkeypatch.setattr(module, "_AUTO_STEPS", (0, 0))
+    monkeypatch.setattr(module, "_SWEEP_CELLS", 10 ** 9)
 
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow,
@@ -668,11 +671,12 @@ def test_tile_workspace_accepts_a_workspace_or_an_array():
 
 
 def test_importing_the_tiler_imports_neither_pymoo_nor_deap():
-    """Nor numba, which only the sweep of auto needs (its import alone takes about half a second)."""
+    """Nor numba, which only the sweep of auto needs (its import alone takes about half a second), nor
+    ortools, which only CP-SAT needs."""
     import subprocess
     import sys
 
     code = ("import sys, htetro_opt.solvers.tiling as t; t.tile_workspace; "
-            "print(sorted(m for m in ('pymoo', 'deap', 'numba') if m in sys.modules))")
+            "print(sorted(m for m in ('pymoo', 'deap', 'numba', 'ortools') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]"
