@@ -21,7 +21,8 @@ def attach(package: str, exports: Mapping[str, str]) -> tuple[Callable, Callable
     package : str
         The package's ``__name__``.
     exports : mapping of str to str
-        Public name → submodule (relative to ``package``, e.g. ``"._exact"``) that defines it.
+        Public name → submodule (relative to ``package``, e.g. ``"._exact"``, or absolute, for a name
+        defined in a lower layer and re-exported) that defines it.
 
     Examples
     --------

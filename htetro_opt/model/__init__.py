@@ -1,7 +1,10 @@
 """The one hTetro robot model shared by every method (shared/MODEL.md): geometry, commands, sweeps,
 workspaces, the batch simulator and the coverage motion model, and the continuous workspaces of
-Nazarahari et al. 2019 (:mod:`~htetro_opt.model.continuous`, loaded on first use: it imports
-shapely). It imports nothing of htetro_opt above it (only its errors and option checks)."""
+Nazarahari et al. 2019 (:mod:`~htetro_opt.model.continuous`; with the geometry that the path-bases
+problem, its operators and the continuous planners share: the lattice and its APF initial paths,
+:func:`apf_population`, and the visibility graph's shortest path, :func:`visibility_path`; all
+loaded on first use: they import shapely). It imports nothing of htetro_opt above it (only its errors
+and option checks)."""
 
 from htetro_opt.model.commands import (
     COMMANDS,
@@ -22,8 +25,14 @@ from htetro_opt.model.simulate import SimulationResult, Simulator, simulate, tra
 from htetro_opt.model.sweeps import SweepTables, sweep_tables
 from htetro_opt.model.workspace import MovingObstacle, Workspace, grid_distance
 
-_CONTINUOUS = ("ContinuousGeometry", "Corners", "as_polygon", "as_robot_radius", "enclosing_radius", "path_length",
-               "path_smoothness", "robot_distance")
+_CONTINUOUS = {  # name → the module that defines it, loaded on first use (shapely)
+    **{name: "continuous" for name in ("ContinuousGeometry", "Corners", "SAFETY_MARGIN", "as_polygon",
+                                       "as_robot_radius", "enclosing_radius", "path_length", "path_smoothness",
+                                       "robot_distance")},
+    "lattice_graph": "_lattice",
+    **{name: "_apf" for name in ("apf_depths", "apf_paths", "apf_population", "turning_points")},
+    "visibility_path": "_visibility",
+}
 
 __all__ = [
     "COMMANDS", "DIAGONAL_COMMANDS", "SEED000_COMMANDS", "SEED004_COMMANDS", "TOKENS", "Command", "Timing",
@@ -38,7 +47,7 @@ __all__ = [
 
 def __getattr__(name: str):
     if name in _CONTINUOUS:  # shapely loads only when the continuous geometry is used
-        from htetro_opt.model import continuous
+        from importlib import import_module
 
-        return getattr(continuous, name)
+        return getattr(import_module(f"{__name__}.{_CONTINUOUS[name]}"), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

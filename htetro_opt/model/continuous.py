@@ -43,6 +43,7 @@ from htetro_opt.errors import ParameterError, UnknownShapeError
 __all__ = [
     "ContinuousGeometry",
     "Corners",
+    "SAFETY_MARGIN",
     "as_polygon",
     "as_robot_radius",
     "closest_approach",
@@ -59,6 +60,10 @@ QUAD_SEGS = 8
 OUTER_FACTOR = 1.0 / math.cos(math.pi / (4 * QUAD_SEGS)) * (1.0 + 1e-9)
 """Radius factor of the outer polygonisation: its chords stay at distance ≥ r from the obstacle (the
 1e-9 keeps a chord's midpoint from landing a rounding error inside)."""
+
+SAFETY_MARGIN = 0.5
+"""Robots closer than 2 r + this conflict (the safety distance d_s; a choice of ours: the paper's
+§4.5 leaves it open), as :func:`robot_distance` measures how close they come."""
 
 
 def as_polygon(value, name: str = "obstacle") -> np.ndarray:

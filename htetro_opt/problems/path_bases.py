@@ -22,7 +22,7 @@ NSGA-II and the like): (ΣL, ΣS, −safety), safety summed over the robots for 
 smallest over them for ``"min"``; −safety rather than 1/safety (ours) keeps the third objective
 finite on paths that touch an obstacle. With K > 1 robots, the penalty of §4.5 is added to C (to ΣL
 in ``"separate"``): 10 (W + H) (d_s − d) / d_s for each pair of robots whose closest approach d is
-below d_s (:data:`~htetro_opt.solvers.continuous.SAFETY_MARGIN`; robots move at unit speed and wait
+below d_s (:data:`~htetro_opt.model.continuous.SAFETY_MARGIN`; robots move at unit speed and wait
 at their goals, as :func:`~htetro_opt.model.robot_distance` measures).
 
 **G** (one inequality constraint, feasible at 0): the number of infeasible segments of all the
@@ -40,7 +40,9 @@ from scipy.interpolate import CubicSpline
 
 from htetro_opt._validation import check_real
 from htetro_opt.errors import ParameterError
-from htetro_opt.model.continuous import path_smoothness, polyline_segments, robot_distance
+from htetro_opt.model._lattice import check_grid
+from htetro_opt.model.continuous import SAFETY_MARGIN, path_smoothness, polyline_segments, robot_distance
+from htetro_opt.scenarios.loader import check_continuous_scenario
 
 __all__ = [
     "PathBasesProblem",
@@ -200,9 +202,7 @@ class PathBasesProblem(Problem):
 
     def __init__(self, scenario, *, path: str = "linear", weights=DEFAULT_PATH_WEIGHTS, safety: str = "paper",
                  objectives: str = "weighted", grid: float = 1.0) -> None:
-        from htetro_opt.solvers.continuous import SAFETY_MARGIN, check_grid, check_scenario
-
-        scenario = check_scenario(scenario)
+        scenario = check_continuous_scenario(scenario)
         self.scenario = scenario
         self.geometry = scenario.geometry
         self.path = _choice(path, "path", PATH_KINDS)

@@ -10,6 +10,7 @@ from htetro_opt.scenarios._paths import as_path
 from htetro_opt.scenarios.loader import (
     ContinuousScenario,
     Scenario,
+    check_continuous_scenario,
     format_grid,
     load_scenario_file,
     parse_grid,
@@ -28,6 +29,7 @@ from htetro_opt.scenarios.tileset import (
 __all__ = [
     "Scenario",
     "ContinuousScenario",
+    "check_continuous_scenario",
     "load_scenario",
     "list_scenarios",
     "scenario_path",

@@ -48,7 +48,8 @@ from htetro_opt.model.workspace import MovingObstacle, Workspace, describe_cells
 from htetro_opt.scenarios._paths import as_path
 from htetro_opt.scenarios.rosmap import load_ros_map
 
-__all__ = ["Scenario", "ContinuousScenario", "load_scenario_file", "parse_scenario", "parse_grid", "format_grid"]
+__all__ = ["Scenario", "ContinuousScenario", "check_continuous_scenario", "load_scenario_file", "parse_scenario",
+           "parse_grid", "format_grid"]
 
 _GRID_KEYS = {"name", "source", "description", "cell_size_m", "grid", "map", "roadmap", "moving", "hidden"}
 _CONTINUOUS_KEYS = {"name", "source", "description", "width", "height", "obstacles", "robot_radius", "robots"}
@@ -185,6 +186,31 @@ class ContinuousScenario:
         source = f"{scenario.source} (as a continuous workspace)" if scenario.source else "a grid scenario"
         return cls(scenario.name, source, width, height, tuple(obstacles), radius, starts, goals,
                    scenario.description, scenario.path)
+
+
+def check_continuous_scenario(scenario) -> ContinuousScenario:
+    """``scenario`` itself if it is a :class:`ContinuousScenario` (what the continuous planners and
+    :class:`~htetro_opt.problems.PathBasesProblem` accept).
+
+    Raises
+    ------
+    ScenarioError
+        For a grid scenario (naming the way across: ``ContinuousScenario.from_grid``) or anything else.
+
+    Examples
+    --------
+    >>> from htetro_opt.scenarios import load_scenario
+    >>> check_continuous_scenario(load_scenario("three_slit"))
+    Traceback (most recent call last):
+    ...
+    htetro_opt.errors.ScenarioError: scenario 'three_slit' is a grid scenario: plan it with plan_path, or convert it with ContinuousScenario.from_grid(scenario, robot_radius=...)
+    """
+    if isinstance(scenario, ContinuousScenario):
+        return scenario
+    if isinstance(scenario, Scenario):
+        raise ScenarioError(f"scenario {scenario.name!r} is a grid scenario: plan it with plan_path, or convert it "
+                            "with ContinuousScenario.from_grid(scenario, robot_radius=...)")
+    raise ScenarioError(f"scenario must be a ContinuousScenario, got {type(scenario).__name__}")
 
 
 def parse_grid(text: str, *, where: str = "grid") -> np.ndarray:

@@ -3,8 +3,8 @@
 The paper's EGA moves PBs by small random steps; on a maze it stalls a few per cent short of the
 wall corners a shortest path wraps around (as its own EGA loses to A* 0.25 on its mazes). Taut
 refinement pulls a path tight in its own corridor: the shortest path from the start to the goal over
-the visibility graph (:func:`~htetro_opt.solvers.continuous.visibility_path`, the exact reference's
-code with its tangent pruning) of the path's own PBs and of the free space's corners within ``reach``
+the visibility graph (:func:`~htetro_opt.model.visibility_path`, the exact reference's code with
+its tangent pruning) of the path's own PBs and of the free space's corners within ``reach``
 (2 d) of the path. The path itself is in that graph, so the result is never longer; it is kept if its
 cost is lower (for a spline or other weights the taut polyline need not be better).
 
@@ -21,6 +21,7 @@ import numpy as np
 from pymoo.core.repair import Repair
 
 from htetro_opt._validation import check_int, check_real
+from htetro_opt.model._visibility import visibility_path
 from htetro_opt.model.continuous import ContinuousGeometry, Corners
 from htetro_opt.operators.path_bases.deletion import TOLERANCE
 
@@ -70,8 +71,6 @@ def taut_path(pbs, start, goal, geometry: ContinuousGeometry, corners: Corners, 
     """
     start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
     pbs = np.asarray(pbs, dtype=float).reshape(-1, 2)
-    from htetro_opt.solvers.continuous import visibility_path  # the solvers package loads after the operators
-
     line = np.vstack([start, pbs, goal])
     near = near_corners(corners, line, reach)
     # a PB is no corner: with itself as both neighbours every segment counts as tangent there

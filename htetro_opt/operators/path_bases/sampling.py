@@ -16,7 +16,7 @@ def initial_paths(geometry, start, goal, n: int, *, grid: float, finer: bool, se
     ``finer`` (ours), the even-numbered ones there and the odd-numbered ones on the lattice of
     spacing ``grid`` / 2, which passes gaps narrower than ``grid`` (the paper's d = 1 lattice misses
     the shortest way between ``ega12_plankpile``'s planks). Empty when the goal is unreachable."""
-    from htetro_opt.solvers.continuous import apf_population  # the solvers package loads after the operators
+    from htetro_opt.model._apf import apf_population  # shapely loads when paths are drawn, not with the operators
 
     coarse, _ = apf_population(geometry, start, goal, n - n // 2 if finer else n, grid=grid, seed=seed)
     if not finer or not coarse or n < 2:

@@ -16,6 +16,11 @@
   initial paths of its enhanced GA.
 
 Every method returns a :class:`ContinuousPlan`, re-validated against the scenario's geometry.
+
+The geometry the problems and operators share with these planners lives below them and is
+re-exported here: the APF, the lattice (:func:`lattice_graph`, :func:`check_grid`),
+:func:`visibility_path` and :data:`SAFETY_MARGIN` in :mod:`htetro_opt.model`, :func:`check_scenario`
+in :mod:`htetro_opt.scenarios` (as ``check_continuous_scenario``).
 """
 
 from htetro_opt._lazy import attach
@@ -23,13 +28,13 @@ from htetro_opt._lazy import attach
 __getattr__, __dir__, __all__ = attach(__name__, {
     "plan_continuous": "._dispatch", "CONTINUOUS_METHODS": "._dispatch",
     "ContinuousPlan": "._result", "SAFETY_MARGIN": "._result", "check_scenario": "._result",
-    "check_grid": "._astar",
-    "visibility_path": "._exact",
-    "lattice_path": "._astar", "lattice_graph": "._astar",
+    "check_grid": "htetro_opt.model._lattice",
+    "visibility_path": "htetro_opt.model._visibility",
+    "lattice_path": "._astar", "lattice_graph": "htetro_opt.model._lattice",
     "plan_ega": "._ega", "plan_ega_paper": "._ega", "plan_moea": "._ega", "plan_nsga2": "._ega",
     "MOEA_ALGORITHMS": "._ega",
     "prm_path": "._prm", "plan_prm": "._prm", "PAPER_PRM": "._prm",
     "rrt_path": "._rrt", "plan_rrt": "._rrt",
     "pso_path": "._pso", "plan_pso": "._pso", "pad_path_bases": "._pso", "keep_feasible_moves": "._pso",
-    "apf_depths": "._apf", "apf_paths": "._apf", "apf_population": "._apf", "turning_points": "._apf",
+    **{name: "htetro_opt.model._apf" for name in ("apf_depths", "apf_paths", "apf_population", "turning_points")},
 })

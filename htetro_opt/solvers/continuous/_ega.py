@@ -14,8 +14,8 @@ import numpy as np
 
 from htetro_opt._validation import as_rng, check_bool, check_int, derive_seed
 from htetro_opt.errors import ParameterError
+from htetro_opt.model._lattice import check_grid
 from htetro_opt.problems.path_bases import DEFAULT_PATH_WEIGHTS, PathBasesProblem, check_path_weights
-from htetro_opt.solvers.continuous._astar import check_grid
 from htetro_opt.solvers.continuous._result import ContinuousPlan, check_scenario, finish_plan
 
 __all__ = ["plan_ega", "plan_ega_paper", "plan_moea", "plan_nsga2", "MOEA_ALGORITHMS"]

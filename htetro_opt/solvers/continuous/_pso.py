@@ -39,7 +39,7 @@ import time
 import numpy as np
 
 from htetro_opt._validation import as_rng, check_int, derive_seed
-from htetro_opt.solvers.continuous._astar import check_grid
+from htetro_opt.model._lattice import check_grid
 from htetro_opt.solvers.continuous._result import ContinuousPlan, check_scenario, finish_plan
 
 __all__ = ["pad_path_bases", "keep_feasible_moves", "pso_path", "plan_pso", "INERTIA", "DAMPING", "LEARNING",
@@ -173,7 +173,7 @@ def pso_path(geometry, start, goal, *, pop_size: int = 10, max_gen: int = 20, gr
     from pymoo.algorithms.soo.nonconvex.pso import PSO
     from pymoo.optimize import minimize
 
-    from htetro_opt.solvers.continuous._apf import apf_population
+    from htetro_opt.model._apf import apf_population
 
     pop_size = check_int(pop_size, "pop_size", minimum=2)
     max_gen = check_int(max_gen, "max_gen", minimum=0)

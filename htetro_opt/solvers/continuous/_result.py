@@ -14,15 +14,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from htetro_opt.errors import PlanningError, ScenarioError
-from htetro_opt.model.continuous import path_length, path_smoothness, robot_distance
-from htetro_opt.scenarios.loader import ContinuousScenario, Scenario
+from htetro_opt.errors import PlanningError
+from htetro_opt.model.continuous import SAFETY_MARGIN, path_length, path_smoothness, robot_distance
+from htetro_opt.scenarios.loader import ContinuousScenario
+from htetro_opt.scenarios.loader import check_continuous_scenario as check_scenario
 
 __all__ = ["ContinuousPlan", "finish_plan", "check_scenario", "SAFETY_MARGIN"]
-
-SAFETY_MARGIN = 0.5
-"""Robots closer than 2 r + this conflict (the safety distance d_s; a choice of ours: the paper's
-§4.5 leaves it open)."""
 
 
 @dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
@@ -123,22 +120,6 @@ def _finite_or_none(value):
     if isinstance(value, float) and not math.isfinite(value):
         return None
     return value
-
-
-def check_scenario(scenario) -> ContinuousScenario:
-    """``scenario`` itself if it is a :class:`~htetro_opt.scenarios.ContinuousScenario`.
-
-    Raises
-    ------
-    ScenarioError
-        For a grid scenario (naming the way across: ``ContinuousScenario.from_grid``) or anything else.
-    """
-    if isinstance(scenario, ContinuousScenario):
-        return scenario
-    if isinstance(scenario, Scenario):
-        raise ScenarioError(f"scenario {scenario.name!r} is a grid scenario: plan it with plan_path, or convert it "
-                            "with ContinuousScenario.from_grid(scenario, robot_radius=...)")
-    raise ScenarioError(f"scenario must be a ContinuousScenario, got {type(scenario).__name__}")
 
 
 def finish_plan(scenario: ContinuousScenario, paths: Sequence, *, method: str, began: float,

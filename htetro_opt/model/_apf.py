@@ -3,8 +3,8 @@
 The lattice holds the points k·d of F (d = ``grid``, 1 in the paper); two of them one step apart
 (axis or diagonal, i.e. within d√2) are neighbours when the segment between them is feasible. The
 start and the goal, which need not lie on the lattice, are linked to the feasible nodes they see
-within 1.5·d (the lattice of :func:`~htetro_opt.solvers.continuous.lattice_graph`, which the A*
-baseline searches too).
+within 1.5·d (the lattice of :func:`~htetro_opt.model.lattice_graph`, which the A* baseline
+searches too).
 
 **Potential.** Algorithm 1 hands ξ0 to the goal and ξ_i = ξ_{i−1} − α to the nodes first reached at
 the i-th sweep of its OPEN / TEMP / CLOSED lists: a breadth-first search from the goal. We keep its
@@ -27,8 +27,8 @@ import numpy as np
 from scipy.sparse import csr_matrix
 
 from htetro_opt._validation import as_rng, check_int
+from htetro_opt.model._lattice import check_grid, lattice_graph
 from htetro_opt.model.continuous import ContinuousGeometry
-from htetro_opt.solvers.continuous._astar import check_grid, lattice_graph
 
 __all__ = ["apf_depths", "apf_paths", "apf_population", "turning_points", "REFINEMENTS", "FILL_RATE"]
 
