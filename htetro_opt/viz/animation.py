@@ -30,18 +30,16 @@ from htetro_opt.model.robot import HINGE_STATES, as_pose, block_poses, rotate_ce
 from htetro_opt.model.simulate import Simulator
 from htetro_opt.model.sweeps import motion_samples
 from htetro_opt.model.workspace import MovingObstacle, Workspace, check_workspace
-from htetro_opt.viz.plot import (
+from htetro_opt.viz._style import (
     _INTERMEDIATE_COLOUR,
     _MOVING_COLOUR,
-    _OBSTACLE_VALUE,
-    DENSE_CELL_PT,
     SHAPE_COLOURS,
-    _cell_points,
+    _cell_grid,
     _colour,
-    _draw_roadmap,
-    _hidden_cells,
-    _squares,
+    _draw_occupancy,
+    _obstacle_colour,
 )
+from htetro_opt.viz.plot import DENSE_CELL_PT, _cell_points, _draw_roadmap, _hidden_cells, _squares
 
 __all__ = ["MAX_FPS", "PathAnimation", "animate_path", "save_gif"]
 
@@ -425,8 +423,7 @@ def _figure(workspace: Workspace, roadmap, hidden: np.ndarray, title: str, dpi: 
     fig = Figure(figsize=(fig_w, fig_h), dpi=dpi)
     FigureCanvasAgg(fig)
     ax = fig.add_axes((m["left"] / fig_w, m["bottom"] / fig_h, map_w / fig_w, map_h / fig_h))
-    ax.imshow(workspace.occupancy, cmap="Greys", vmin=0, vmax=1.4, origin="lower",
-              extent=(-0.5, w - 0.5, -0.5, h - 0.5), interpolation="nearest", zorder=0)
+    _draw_occupancy(ax, workspace.occupancy)
     ax.set_xlim(-0.5, w - 0.5)
     ax.set_ylim(-0.5, h - 0.5)
     ax.set_xlabel("x (cells)", fontsize=8)
@@ -435,10 +432,7 @@ def _figure(workspace: Workspace, roadmap, hidden: np.ndarray, title: str, dpi: 
     cell_pt = _cell_points(ax, w, h)
     dense = cell_pt < DENSE_CELL_PT
     if not dense:
-        ax.set_xticks(np.arange(-0.5, w, 1), minor=True)
-        ax.set_yticks(np.arange(-0.5, h, 1), minor=True)
-        ax.grid(which="minor", color="#dddddd", linewidth=0.4)
-        ax.tick_params(which="minor", length=0)
+        _cell_grid(ax, w, h, colour="#dddddd", linewidth=0.4)
     if title:
         fig.text(0.5, 1 - m["top"] / fig_h, title, ha="center", va="top", fontsize=9)
     artists = {}
@@ -470,11 +464,10 @@ def _figure(workspace: Workspace, roadmap, hidden: np.ndarray, title: str, dpi: 
 
 def _dynamic_colours() -> tuple[list[str], list[str]]:
     """The colours the animated artists fill with, and those around them (edges, text, the map)."""
-    from matplotlib import colormaps
     from matplotlib.colors import to_hex
 
     fills = [*SHAPE_COLOURS.values(), _INTERMEDIATE_COLOUR, _MOVING_COLOUR]
-    return fills, ["white", "black", _EDGE_COLOUR, "#dddddd", to_hex(colormaps["Greys"](_OBSTACLE_VALUE))]
+    return fills, ["white", "black", _EDGE_COLOUR, "#dddddd", to_hex(_obstacle_colour())]
 
 
 def _palette(background: np.ndarray, colours: tuple[list[str], list[str]]):

@@ -3,7 +3,7 @@ C-obstacles' outline for a disc robot), several methods' paths with their path b
 method under several weights (Fig. 10), the robots where two come closest (Fig. 11), the APF's
 potential (Fig. 3) and a multi-objective front.
 
-matplotlib is imported lazily (:mod:`htetro_opt.viz.plot`); nothing here plans: the figures draw
+matplotlib is imported lazily (:mod:`htetro_opt.viz._style`); nothing here plans: the figures draw
 :class:`~htetro_opt.solvers.continuous.ContinuousPlan` objects and scenarios as they are.
 """
 
@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from htetro_opt.errors import ParameterError
-from htetro_opt.viz.plot import _pyplot
+from htetro_opt.viz._style import _colour_bar, _legend, _pyplot
 
 __all__ = ["plot_continuous", "plot_apf_potential", "plot_continuous_front", "PLAN_COLOURS"]
 
@@ -138,7 +138,7 @@ def plot_continuous(scenario, plans=(), *, ax=None, title: str = "", path_bases:
                                         gid=f"closest-{p}"))
             ax.plot(*np.transpose(spots), ":", color="black", linewidth=1.0,
                     label=f"closest approach {distance:.2f} (t = {t:.1f})" if p == 0 else None)
-    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
+    _legend(ax, ax.get_legend_handles_labels()[0], x=1.02)
     ax.set_title(title or scenario.name)
     return fig
 
@@ -180,7 +180,7 @@ def plot_apf_potential(scenario, *, robot: int = 0, grid: float = 1.0, n_paths: 
     seen = depth >= 0
     dots = ax.scatter(nodes[seen, 0], nodes[seen, 1], c=-depth[seen], s=size, cmap="viridis", gid="potential")
     ax.scatter(nodes[~seen, 0], nodes[~seen, 1], s=size, facecolors="none", edgecolors="#bbbbbb", gid="unreached")
-    fig.colorbar(dots, ax=ax, label="potential (−hops to the goal)", shrink=0.8)
+    _colour_bar(ax, dots, "potential (−hops to the goal)", shrink=0.8)
     paths, _ = apf_paths(scenario.geometry, start, goal, n_paths=n_paths, grid=grid, seed=seed)
     for i, pbs in enumerate(paths):
         line = np.vstack([start, pbs, goal])
@@ -213,7 +213,7 @@ def plot_continuous_front(plan, *, ax=None, title: str = ""):
     else:
         fig = ax.figure
     dots = ax.scatter(values[:, 0], values[:, 1], c=values[:, 2], cmap="viridis", gid="front")
-    fig.colorbar(dots, ax=ax, label="safety")
+    _colour_bar(ax, dots, "safety")
     ax.set_xlabel("length")
     ax.set_ylabel("smoothness (degrees)")
     ax.set_title(title or f"{plan.scenario}: {plan.method} front ({len(front)} members)")

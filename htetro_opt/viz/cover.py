@@ -13,18 +13,15 @@ import numpy as np
 from htetro_opt.errors import ParameterError
 from htetro_opt.model.robot import shape_index
 from htetro_opt.model.workspace import Workspace, check_workspace
+from htetro_opt.viz._style import SHAPE_COLOURS, _legend, _marker_handle, _pyplot
 from htetro_opt.viz.plot import (
     DENSE_CELL_PT,
-    SHAPE_COLOURS,
     _cell_points,
     _draw_map,
     _footprint_cells,
     _frame,
-    _legend,
     _map_figure,
-    _marker_handle,
     _outline_segments,
-    _pyplot,
 )
 
 __all__ = ["plot_cover", "plot_cover_heat", "LAYER_COLOURS"]

@@ -18,7 +18,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from htetro_opt.errors import ParameterError
-from htetro_opt.viz.plot import _FITNESS_STYLES, _marker_handle, _pyplot
+from htetro_opt.viz._style import _FITNESS_STYLES, _legend, _marker_handle, _pyplot
 
 __all__ = ["DEFAULT_OBJECTIVES", "FITNESS_OBJECTIVES", "plot_convergence", "plot_fronts", "plot_parallel"]
 
@@ -318,7 +318,7 @@ def plot_parallel(fronts, *, labels=None, objectives=DEFAULT_OBJECTIVES, title: 
     ax.set_ylabel(f"each axis from its minimum to its maximum\n{_BETTER}")
     for spine in ax.spines.values():
         spine.set_visible(False)
-    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
+    _legend(ax, handles)
     if title:
         ax.set_title(title, fontsize=10)
     return fig

@@ -21,16 +21,13 @@ from htetro_opt._validation import check_bool, check_int
 from htetro_opt.errors import HtetroError, ParameterError
 from htetro_opt.model.robot import STATE_NAMES, Pose, as_pose
 from htetro_opt.model.workspace import Workspace, check_workspace
+from htetro_opt.viz._style import _ROADMAP_COLOURS, _colour_bar, _legend, _marker_handle, _pyplot
 from htetro_opt.viz.plot import (
-    _ROADMAP_COLOURS,
     DENSE_CELL_PT,
     _cell_points,
     _draw_map,
     _frame,
-    _legend,
     _map_figure,
-    _marker_handle,
-    _pyplot,
     figure_format,
     plot_path,
     save_figure,
@@ -225,8 +222,7 @@ def _draw_heat(ax, field, workspace: Workspace, poses, replans: list[Pose], *, a
         handles += _draw_track(ax, poses, dense=dense)
     handles += _draw_replans(ax, replans)
     if colorbar:
-        bar = ax.figure.colorbar(image, ax=ax, shrink=0.85, pad=0.02)
-        bar.set_label("temperature T (sink: start 0, source: goal 1)")
+        _colour_bar(ax, image, "temperature T (sink: start 0, source: goal 1)", shrink=0.85, pad=0.02)
     _frame(ax, workspace, "temperature field T and ∇T" if title is None else title)
     if handles:
         ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2, fontsize=8,

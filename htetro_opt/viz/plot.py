@@ -21,35 +21,29 @@ from htetro_opt._files import atomic_path, check_output_path
 from htetro_opt.errors import ParameterError
 from htetro_opt.model.robot import FOOTPRINTS, N_NAMED, SHAPES, Pose
 from htetro_opt.model.workspace import Workspace
+from htetro_opt.viz._style import (
+    _INTERMEDIATE_COLOUR,
+    _MOVING_COLOUR,
+    _ROADMAP_COLOURS,
+    SHAPE_COLOURS,
+    _cell_grid,
+    _colour,
+    _draw_occupancy,
+    _legend,
+    _marker_handle,
+    _obstacle_colour,
+    _pyplot,
+)
+from htetro_opt.viz.fronts import _draw_convergence
 
 __all__ = ["SHAPE_COLOURS", "SELECTION_STYLES", "DENSE_CELL_PT", "plot_path", "plot_ga_plan", "save_figure",
            "figure_format"]
 
-SHAPE_COLOURS = {
-    "I": "#1f77b4", "O": "#ff7f0e", "L": "#2ca02c", "J": "#d62728",
-    "Z": "#9467bd", "S": "#8c564b", "T": "#e377c2",
-}
-_INTERMEDIATE_COLOUR = "#7f7f7f"
-_OBSTACLE_VALUE = 1 / 1.4  # where the occupancy's "Greys" map (vmax 1.4) puts an obstacle
 _HIDDEN_HIT_COLOUR = "#d00000"
-_MOVING_COLOUR = "#1b4f72"
-_ROADMAP_COLOURS = {"start": "green", "intermediate roadmap pose": "blue", "goal": "red"}
 
 DENSE_CELL_PT = 9.0
 """Side of a cell on the figure, in points (1/72 in), below which plots switch from outlines and
 labels to markers (9 pt is 12.5 pixels at 100 dpi)."""
-
-
-def _pyplot():
-    # The backend is the caller's choice (a notebook's inline one, a desktop's window); the command
-    # line picks Agg itself. Forcing Agg here would stop a notebook from showing the figures.
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _colour(state: int) -> str:
-    return SHAPE_COLOURS[SHAPES[state]] if state < N_NAMED else _INTERMEDIATE_COLOUR
 
 
 def _footprint_cells(poses) -> np.ndarray:
@@ -120,34 +114,18 @@ def _mixed_image(counts: np.ndarray, colours, alpha: float, *, cap: float = 0.9)
     return image
 
 
-def _legend(ax, handles) -> None:
-    if handles:
-        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
-
-
-def _marker_handle(label: str, **style):
-    from matplotlib.lines import Line2D
-
-    return Line2D([], [], linestyle=style.pop("linestyle", "none"), label=label, **style)
-
-
 def _draw_map(ax, workspace: Workspace, hidden, *, dense: bool) -> list:
     """Static obstacles, moving obstacles and their tracks, hidden obstacles; their legend handles."""
     from matplotlib.collections import PolyCollection
     from matplotlib.patches import Patch
 
-    plt = _pyplot()
     w, h = workspace.width, workspace.height
-    ax.imshow(workspace.occupancy, cmap="Greys", vmin=0, vmax=1.4, origin="lower",
-              extent=(-0.5, w - 0.5, -0.5, h - 0.5), interpolation="nearest", zorder=0)
+    _draw_occupancy(ax, workspace.occupancy)
     handles = []
     if workspace.occupancy.any():
-        handles.append(Patch(facecolor=plt.get_cmap("Greys")(_OBSTACLE_VALUE), label="obstacle"))
+        handles.append(Patch(facecolor=_obstacle_colour(), label="obstacle"))
     if not dense:
-        ax.set_xticks(np.arange(-0.5, w, 1), minor=True)
-        ax.set_yticks(np.arange(-0.5, h, 1), minor=True)
-        ax.grid(which="minor", color="#dddddd", linewidth=0.4)
-        ax.tick_params(which="minor", length=0)
+        _cell_grid(ax, w, h, colour="#dddddd", linewidth=0.4)
     if workspace.moving:
         tracks = np.unique(np.concatenate([m.cells_at(t) for m in workspace.moving for t in range(m.period)]), axis=0)
         starts = np.concatenate([m.cells_at(0) for m in workspace.moving])
@@ -364,8 +342,6 @@ SELECTION_STYLES = {
 }
 """Colour and legend label of each of the paper's four output solutions (Cheng et al. 2020, Fig. 9)."""
 
-_FITNESS_STYLES = (("f_gr", "black"), ("f_t", "#1f77b4"), ("f_sm", "#2ca02c"), ("f_sf", "#9467bd"))
-
 
 def _selection_track(plan, name: str, offset: float):
     """B2's track of one selection over every leg (NaN between legs) and its total time, or None."""
@@ -423,8 +399,6 @@ def plot_ga_plan(workspace: Workspace, plan, *, roadmap: tuple[Pose, ...] = (), 
     _frame(ax_map, workspace, title)
 
     if plan.legs:
-        from htetro_opt.viz.fronts import _draw_convergence  # the one convergence drawing (fronts imports this module)
-
         _draw_convergence(ax_fit, [(np.asarray(leg.history, dtype=float).reshape(-1, 4), leg.reach_generation)
                                    for leg in plan.legs])
     ax_fit.set_title("convergence of the multi-objective solution's fitnesses", fontsize=10)

@@ -11,17 +11,8 @@ import numpy as np
 
 from htetro_opt.errors import HtetroError, ParameterError
 from htetro_opt.scenarios.tileset import BLOCK_LETTERS, Tileset
-from htetro_opt.viz.plot import (
-    DENSE_CELL_PT,
-    SHAPE_COLOURS,
-    _cell_points,
-    _legend,
-    _mixed_image,
-    _outline_segments,
-    _pyplot,
-    _shape_counts,
-    _squares,
-)
+from htetro_opt.viz._style import SHAPE_COLOURS, _cell_grid, _colour_bar, _legend, _pyplot
+from htetro_opt.viz.plot import DENSE_CELL_PT, _cell_points, _mixed_image, _outline_segments, _shape_counts, _squares
 
 __all__ = ["plot_tileset", "plot_coverage"]
 
@@ -259,8 +250,7 @@ def plot_coverage(result, *, title: str = "", ax=None):
     cmap = plt.get_cmap("RdYlGn_r").with_extremes(bad="white")
     image = ax.imshow(heat, cmap=cmap, vmin=0, vmax=255, origin="lower", interpolation="nearest",
                       extent=(-0.5, w - 0.5, -0.5, h - 0.5))
-    bar = fig.colorbar(image, ax=ax, shrink=0.85)
-    bar.set_label("coverage time, normalised (0–255)", fontsize=8)
+    _colour_bar(ax, image, "coverage time, normalised (0–255)", shrink=0.85, fontsize=8)
     blocked = np.argwhere(~result.free)[:, ::-1]
     handles = [Patch(facecolor="white", edgecolor="#888888", label="never covered")]
     if len(blocked):
@@ -271,10 +261,7 @@ def plot_coverage(result, *, title: str = "", ax=None):
     ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncols=len(handles), fontsize=8,
               frameon=False)
     if w <= 64 and h <= 64:
-        ax.set_xticks(np.arange(-0.5, w, 1), minor=True)
-        ax.set_yticks(np.arange(-0.5, h, 1), minor=True)
-        ax.grid(which="minor", color="#888888", linewidth=0.3)
-        ax.tick_params(which="minor", length=0)
+        _cell_grid(ax, w, h, colour="#888888", linewidth=0.3)
     per_block = f"{result.mean_block_distance:.1f} cells"
     if result.distance_m is not None:
         per_block += f" = {result.distance_m / 4:.2f} m"
