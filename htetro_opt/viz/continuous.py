@@ -22,6 +22,7 @@ PLAN_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#17becf"
 """One colour per plan (methods, weights), or per robot when one plan is drawn."""
 
 _OBSTACLE = "#7f7f7f"
+_UNITS = "map units"  # a continuous scenario's coordinates have no unit of their own (from a grid: cells)
 
 
 def _check_scenario(scenario):
@@ -60,14 +61,24 @@ def _workspace(ax, scenario, *, outline: bool) -> None:
     ax.set_xlim(-0.02 * scenario.width, 1.02 * scenario.width)
     ax.set_ylim(-0.02 * scenario.height, 1.02 * scenario.height)
     ax.set_aspect("equal")
+    ax.set_xlabel(f"x ({_UNITS})")
+    ax.set_ylabel(f"y ({_UNITS})")
 
 
 def _label(plan) -> str:
+    """The plan's legend entry: method (and weights), total length over the robots that reached
+    their goals, and which did not."""
     weights = plan.info.get("weights")
     label = plan.method
     if weights is not None and list(weights) != [1.0, 0.0, 0.0]:
         label += " W=(" + ", ".join(f"{w:.3g}" for w in weights) + ")"
-    return f"{label}: {plan.length:.2f}"
+    missed = [k for k, reached in enumerate(plan.robots_reached) if not reached]
+    if not missed:
+        return f"{label}: {plan.length:.2f}"
+    if len(missed) == len(plan.robots_reached):
+        return f"{label}: {'goal not' if len(missed) == 1 else 'no goal'} reached"
+    robots = f"robot{'s' if len(missed) > 1 else ''} {', '.join(map(str, missed))}"
+    return f"{label}: {plan.length:.2f} ({robots} not reached)"
 
 
 def plot_continuous(scenario, plans=(), *, ax=None, title: str = "", path_bases: bool = True,
@@ -83,7 +94,8 @@ def plot_continuous(scenario, plans=(), *, ax=None, title: str = "", path_bases:
         Draw there (default: a new figure).
     title : str, keyword-only
     path_bases : bool, keyword-only
-        Mark each path's PBs (``info["path_bases"]`` for the GAs, else the path's interior vertices).
+        Mark each path's PBs (``info["path_bases"]`` where it gives their points, as the GAs' plans do;
+        else the path's interior vertices, as for the PSO's and the graph searches' plans).
     closest : bool, keyword-only
         For a plan of several robots, draw the two that come closest as discs of radius r at that
         moment, joined by a dotted line (Fig. 11).
@@ -93,6 +105,9 @@ def plot_continuous(scenario, plans=(), *, ax=None, title: str = "", path_bases:
     Returns
     -------
     matplotlib Figure
+        The map in its own coordinates (axes labelled "x (map units)", "y (map units)") and the
+        legend right of it: start, goal, and per plan its method, its total length over the robots
+        that reached their goals and those that did not (which have no line).
 
     Raises
     ------
@@ -113,18 +128,20 @@ def plot_continuous(scenario, plans=(), *, ax=None, title: str = "", path_bases:
             gid="starts")
     ax.plot(scenario.goals[:, 0], scenario.goals[:, 1], "*", color="black", markersize=10, label="goal", gid="goals")
     for p, plan in enumerate(plans):
+        label = _label(plan)  # on the plan's first line drawn
         for k, path in enumerate(plan.paths):
             if not len(path):
                 continue
             colour = PLAN_COLOURS[(k if len(plans) == 1 else p) % len(PLAN_COLOURS)]
-            label = _label(plan) if k == 0 else None
             ax.plot(path[:, 0], path[:, 1], "-", color=colour, linewidth=1.5, label=label, gid=f"path-{p}-{k}")
+            label = None
             if path_bases:
-                bases = plan.info.get("path_bases")
-                pbs = np.asarray(bases[k], dtype=float).reshape(-1, 2) if bases and bases[k] is not None else path[1:-1]
+                pbs = _path_bases(plan, k, path)
                 if len(pbs):
                     ax.plot(pbs[:, 0], pbs[:, 1], "o", color=colour, markersize=3.5, markerfacecolor="white",
                             gid=f"pbs-{p}-{k}")
+        if label is not None:  # no robot reached its goal: the legend still names the plan
+            ax.plot([], [], "-", color=PLAN_COLOURS[p % len(PLAN_COLOURS)], linewidth=1.5, label=label)
         reached = [k for k in range(len(plan.paths)) if plan.robots_reached[k] and len(plan.paths[k])]
         if closest and len(reached) > 1:
             best = min(((closest_approach(plan.paths[a], plan.paths[b]), a, b) for i, a in enumerate(reached)
@@ -141,6 +158,20 @@ def plot_continuous(scenario, plans=(), *, ax=None, title: str = "", path_bases:
     _legend(ax, ax.get_legend_handles_labels()[0], x=1.02)
     ax.set_title(title or scenario.name)
     return fig
+
+
+def _path_bases(plan, k: int, path: np.ndarray) -> np.ndarray:
+    """Robot ``k``'s path bases as an (m, 2) array: the GAs' ``info["path_bases"][k]`` (points),
+    else the path's interior vertices (a PSO path runs through its PBs and its ``info`` gives only
+    their count; the graph searches' plans give none)."""
+    bases = plan.info.get("path_bases")
+    listed = isinstance(bases, (Sequence, np.ndarray)) and not isinstance(bases, str)
+    entry = bases[k] if listed and k < len(bases) else None
+    if entry is not None and not isinstance(entry, (int, float, np.number)):
+        points = np.asarray(entry, dtype=float)
+        if points.size == 0 or (points.ndim == 2 and points.shape[1] == 2):
+            return points.reshape(-1, 2)
+    return path[1:-1]
 
 
 def _at(path: np.ndarray, t: float) -> np.ndarray:

@@ -4,14 +4,73 @@ PBs, the obstacles (and C-obstacles), the closest approach; bad inputs raise typ
 import numpy as np
 import pytest
 
+from PIL import Image
+
 from htetro_opt.errors import ParameterError
-from htetro_opt.scenarios import load_scenario
-from htetro_opt.solvers.continuous import plan_continuous
+from htetro_opt.scenarios import load_scenario, parse_scenario
+from htetro_opt.solvers.continuous import CONTINUOUS_METHODS, plan_continuous
 from htetro_opt.viz import plot_apf_potential, plot_continuous, plot_continuous_front, save_figure
+
+SMALL = {"prm": {"seed": 0}, "rrt": {"seed": 0, "time_limit": 0.2}, "pso": {"seed": 0, "pop_size": 6, "max_gen": 3},
+         "ega": {"seed": 0, "pop_size": 6, "max_gen": 3}, "ega-paper": {"seed": 0, "pop_size": 6, "max_gen": 3},
+         "nsga2": {"seed": 0, "pop_size": 6, "max_gen": 3}}
+"""Options that keep every method's plan of a small map short (the graph searches take none)."""
 
 
 def by_gid(ax, gid):
     return [a for a in ax.get_children() if a.get_gid() == gid]
+
+
+def assert_png(path):
+    assert path.stat().st_size > 0
+    with Image.open(path) as image:
+        assert image.format == "PNG"
+        image.verify()
+
+
+def assert_paths_drawn(ax, plan, p=0):
+    for k, path in enumerate(plan.paths):
+        lines = by_gid(ax, f"path-{p}-{k}")
+        if len(path):
+            assert len(lines) == 1 and np.array_equal(np.column_stack(lines[0].get_data()), path)
+        else:
+            assert not lines  # a robot that did not reach its goal has no line
+
+
+@pytest.mark.parametrize("method, name", [(m, "ega07_slits1") for m in CONTINUOUS_METHODS]
+                         + [("ega", "ega_cross4"), ("pso", "ega_cross4")])
+def test_every_method_s_plan_is_drawn_and_saved(method, name, tmp_path):
+    sc = load_scenario(name)
+    plan = plan_continuous(sc, method=method, **SMALL.get(method, {}))
+    ax = plot_continuous(sc, plan, title=method).axes[0]
+    assert ax.get_xlabel() == "x (map units)" and ax.get_ylabel() == "y (map units)"
+    assert_paths_drawn(ax, plan)
+    if method == "pso":  # its info gives the PBs' count: the PBs drawn are the path's interior vertices
+        for k, path in enumerate(plan.paths):
+            pbs = by_gid(ax, f"pbs-0-{k}")
+            assert len(pbs) == (len(path) > 2)
+            if pbs:
+                assert np.array_equal(np.column_stack(pbs[0].get_data()), path[1:-1])
+    assert_png(save_figure(ax.figure, tmp_path / f"{method}.png"))
+
+
+def test_plans_with_a_robot_short_of_its_goal_are_drawn_and_say_so(tmp_path):
+    walled = {"name": "walled", "width": 10, "height": 10,  # a goal at (7.5, 8) inside a closed box
+              "obstacles": [[6, 6, 9, 7], [6, 9, 9, 10], [6, 6, 7, 10], [8, 6, 9, 10]]}
+    boxed, free = {"start": [1, 5], "goal": [7.5, 8]}, {"start": [1, 1], "goal": [9, 2]}
+    first_boxed = parse_scenario({**walled, "robots": [boxed, free]})
+    alone = parse_scenario({**walled, "robots": [boxed]})
+    for method in CONTINUOUS_METHODS:
+        plan = plan_continuous(first_boxed, method=method, **SMALL.get(method, {}))
+        assert plan.robots_reached == (False, True), method
+        ax = plot_continuous(first_boxed, plan).axes[0]
+        assert_paths_drawn(ax, plan)
+        labels = ax.get_legend_handles_labels()[1]
+        assert labels[2].startswith(f"{method}: ") and labels[2].endswith(" (robot 0 not reached)"), labels
+        assert_png(save_figure(ax.figure, tmp_path / f"{method}.png"))
+    plan = plan_continuous(alone, method="pso", **SMALL["pso"])
+    ax = plot_continuous(alone, plan).axes[0]
+    assert not plan.reached and "pso: goal not reached" in ax.get_legend_handles_labels()[1]
 
 
 def test_paths_and_path_bases_are_the_plans(tmp_path):
