@@ -17,10 +17,10 @@ from htetro_opt._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
     "HTetroGA": ".htetro_ga", "trim_reached": ".htetro_ga",
-    "FrontConvergence": ".termination", "HypervolumeWindow": ".termination", "CONVERGENCE_MEASURES": ".termination", "reaching_hypervolume": ".termination",
-    "GA_ALGORITHMS": ".factory", "make_algorithm": ".factory", "ReplanMating": ".factory",
+    "FrontConvergence": ".termination", "HypervolumeWindow": ".termination", "CONVERGENCE_MEASURES": ".names", "reaching_hypervolume": ".termination",
+    "GA_ALGORITHMS": ".names", "make_algorithm": ".factory", "ReplanMating": ".factory",
     "ConservativeMating": ".factory",
-    "SELECTIONS": ".solutions", "PICKS": ".solutions", "leading_front": ".solutions", "select_solutions": ".solutions",
+    "SELECTIONS": ".names", "PICKS": ".names", "leading_front": ".solutions", "select_solutions": ".solutions",
     "ConvergenceRecorder": ".solutions",
     "EnhancedGA": ".enhanced_ga", "make_path_algorithm": ".enhanced_ga", "PATH_ALGORITHMS": ".enhanced_ga",
 })

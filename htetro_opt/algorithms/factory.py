@@ -16,6 +16,7 @@ from pymoo.core.population import Population
 
 from htetro_opt._validation import check_bool, check_int, check_probability, check_real
 from htetro_opt.algorithms.htetro_ga import HTetroGA, trim_reached
+from htetro_opt.algorithms.names import GA_ALGORITHMS
 from htetro_opt.errors import ParameterError
 from htetro_opt.operators.commands import (
     CommandCrossover,
@@ -30,7 +31,7 @@ from htetro_opt.operators.commands import (
     replan_rows,
 )
 
-__all__ = ["GA_ALGORITHMS", "ConservativeMating", "ReplanMating", "make_algorithm"]
+__all__ = ["ConservativeMating", "ReplanMating", "make_algorithm"]
 
 _PYMOO_REPLAN = (0, 3)  # pymoo's algorithms: the re-planning off unless asked for (W), K when it is on
 
@@ -115,10 +116,6 @@ class ReplanMating(InfillCriterion):
         replanned = self.replan.do(problem, Population.new(X=pop.get("X")[rows]), random_state=random_state)
         replanned = self.eliminate_duplicates.do(replanned, pop, off)
         return Population.merge(off, replanned) if len(replanned) else off
-
-GA_ALGORITHMS = ("htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea")
-"""Algorithm names :func:`make_algorithm` knows: the hTetro-GA with our additions, as published, and
-four of pymoo's."""
 
 
 def make_algorithm(

@@ -13,23 +13,11 @@ import numpy as np
 from pymoo.core.callback import Callback
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
+from htetro_opt.algorithms.names import PICKS, SELECTIONS
 from htetro_opt.errors import PlanningError
 from htetro_opt.operators.commands.survival import reaches_goal
 
-__all__ = ["SELECTIONS", "PICKS", "leading_front", "select_solutions", "ConvergenceRecorder"]
-
-SELECTIONS = ("multi_objective", "time", "smoothness", "safety")
-"""The paper's four output solutions: largest fitness sum in F0, then best f_t, f_sm, f_sf."""
-
-PICKS = {"balanced": "multi_objective", "fastest": "time", "smoothest": "smoothness", "safest": "safety"}
-"""Which of the four solutions a planner returns, by the name the planner and the CLI take (``pick``).
-
-Cheng et al. 2020 contradicts itself here: §VI, presenting Table 4, says the output solution is
-"the individual with the smallest crowding distance" in F0; §VI-B (Figs. 9 and 10) that the
-multi-objective based solutions are the individuals "with the maximum sum of the four fitness values"
-within F0. ``"balanced"`` is the latter;
-the former is not offered (the extremes of a front have infinite crowding distance, so the
-"smallest" is an arbitrary interior member)."""
+__all__ = ["leading_front", "select_solutions", "ConvergenceRecorder"]
 
 
 def leading_front(F: np.ndarray) -> np.ndarray:

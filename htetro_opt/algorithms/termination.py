@@ -13,14 +13,11 @@ from pymoo.core.termination import Termination
 from pymoo.util.sliding_window import SlidingWindow
 
 from htetro_opt._validation import check_int, check_real
+from htetro_opt.algorithms.names import CONVERGENCE_MEASURES
 from htetro_opt.errors import ParameterError
 from htetro_opt.operators.commands.survival import reaches_goal
 
-__all__ = ["FrontConvergence", "HypervolumeWindow", "CONVERGENCE_MEASURES", "reaching_hypervolume"]
-
-CONVERGENCE_MEASURES = ("best", "hypervolume")
-"""What :class:`FrontConvergence` watches: the best of each fitness, or the best time and the
-hypervolume of the goal-reaching individuals."""
+__all__ = ["FrontConvergence", "HypervolumeWindow", "reaching_hypervolume"]
 
 _DEFAULT_TOLERANCE = {"best": 1e-9, "hypervolume": 1e-5}
 

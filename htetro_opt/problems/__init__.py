@@ -19,14 +19,15 @@ from htetro_opt._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
     **{name: ".command_path" for name in
-       ("CommandPathProblem", "FITNESS_NAMES", "SAFETY_COEFFICIENT", "SAFETY_PATTERN", "safety_field")},
+       ("CommandPathProblem", "SAFETY_COEFFICIENT", "SAFETY_PATTERN", "safety_field")},
+    **{name: ".names" for name in
+       ("FITNESS_NAMES", "PATH_KINDS", "SAFETY_KINDS", "OBJECTIVE_KINDS", "DEFAULT_PATH_WEIGHTS")},
     **{name: ".waypoint_sequencing" for name in
        ("DEFAULT_BLOCK_WEIGHTS", "DENSE_LIMIT", "SequencingInstance", "block_locations", "check_weights",
         "cost_matrix", "eq2_legs", "path_cost", "check_instance")},
     "SequencingProblem": "._sequencing_problem",
     **{name: ".path_bases" for name in
-       ("PathBasesProblem", "PATH_KINDS", "SAFETY_KINDS", "OBJECTIVE_KINDS", "DEFAULT_PATH_WEIGHTS",
-        "check_path_weights", "spline_path", "render_path")},
+       ("PathBasesProblem", "check_path_weights", "spline_path", "render_path")},
     **{name: ".heat_costs" for name in
        ("HEAT_COST_NAMES", "SAFETY_RADIUS", "check_heat_weights", "default_t_max", "safety_pattern",
         "heat_fitness")},

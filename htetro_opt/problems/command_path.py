@@ -41,7 +41,6 @@ __all__ = [
     "CommandPathProblem",
     "SAFETY_COEFFICIENT",
     "SAFETY_PATTERN",
-    "FITNESS_NAMES",
     "safety_field",
 ]
 
@@ -67,9 +66,6 @@ def _smoothness_safety(keys, local, executed, n_columns, pose_danger, changes, t
             acc = value if t == 0 else acc + value
         total[b] = acc
 
-
-FITNESS_NAMES = ("f_gr", "f_t", "f_sm", "f_sf")
-"""The four fitnesses f_gr, f_t, f_sm, f_sf in objective order."""
 
 SAFETY_PATTERN = np.array(
     [(dx, dy) for dy in range(-2, 3) for dx in range(-2, 3) if 0 < dx * dx + dy * dy <= 4], dtype=np.int64

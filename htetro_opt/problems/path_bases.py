@@ -42,25 +42,16 @@ from htetro_opt._validation import check_real
 from htetro_opt.errors import ParameterError
 from htetro_opt.model._lattice import check_grid
 from htetro_opt.model.continuous import SAFETY_MARGIN, path_smoothness, polyline_segments, robot_distance
+from htetro_opt.problems.names import DEFAULT_PATH_WEIGHTS, OBJECTIVE_KINDS, PATH_KINDS, SAFETY_KINDS
 from htetro_opt.scenarios.loader import check_continuous_scenario
 
 __all__ = [
     "PathBasesProblem",
-    "PATH_KINDS",
-    "SAFETY_KINDS",
-    "OBJECTIVE_KINDS",
-    "DEFAULT_PATH_WEIGHTS",
     "TINY_SAFETY",
     "check_path_weights",
     "spline_path",
     "render_path",
 ]
-
-PATH_KINDS = ("linear", "spline")
-SAFETY_KINDS = ("paper", "min")
-OBJECTIVE_KINDS = ("weighted", "separate")
-DEFAULT_PATH_WEIGHTS = (1.0, 0.0, 0.0)
-"""(W_L, W_S, W_R) of eq. 6: length only, the paper's single-objective comparison (§5.2)."""
 
 TINY_SAFETY = 1e-9
 """The safety a path without clearance counts as in W_R / safety (eq. 6 divides by it)."""

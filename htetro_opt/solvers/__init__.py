@@ -10,6 +10,10 @@
 - :mod:`~htetro_opt.solvers.continuous`: :func:`plan_continuous` (Nazarahari et al. 2019: the exact
   visibility-graph reference, lattice A*).
 
+Each task declares itself once in its spec (``SPEC`` of each subpackage, :mod:`htetro_opt._spec`):
+its methods, their options, defaults and capabilities; :data:`TASKS` names the five. Every result
+extends :class:`Result` (``method``, ``success``, ``message``, ``runtime_s``, ``info``, ``as_dict()``).
+
 The subpackages load lazily: importing one does not import the others' dependencies.
 """
 
@@ -17,9 +21,10 @@ from htetro_opt._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
     "plan_path": ".grid_paths", "plan_exact": ".grid_paths", "plan_ga": ".grid_paths", "Plan": ".grid_paths",
-    "PLAN_METHODS": ".grid_paths",
-    "tile_workspace": ".tiling", "enumerate_tilings": ".tiling", "find_tiles": ".tiling", "TILING_METHODS": ".tiling",
-    "sequence_waypoints": ".sequencing", "SequenceResult": ".sequencing", "SEQUENCE_METHODS": ".sequencing",
-    "plan_coverage": ".coverage", "CoveragePlan": ".coverage", "COVERAGE_METHODS": ".coverage",
-    "plan_continuous": ".continuous", "ContinuousPlan": ".continuous", "CONTINUOUS_METHODS": ".continuous",
+    "tile_workspace": ".tiling", "enumerate_tilings": ".tiling", "find_tiles": ".tiling",
+    "TilingResult": ".tiling",
+    "sequence_waypoints": ".sequencing", "SequenceResult": ".sequencing",
+    "plan_coverage": ".coverage", "CoveragePlan": ".coverage",
+    "plan_continuous": ".continuous", "ContinuousPlan": ".continuous",
+    "Result": "._result", "TASKS": "._tasks",
 })

@@ -26,7 +26,7 @@ in :mod:`htetro_opt.scenarios` (as ``check_continuous_scenario``).
 from htetro_opt._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
-    "plan_continuous": "._dispatch", "CONTINUOUS_METHODS": "._dispatch",
+    "plan_continuous": "._dispatch", "SPEC": "._spec",
     "ContinuousPlan": "._result", "SAFETY_MARGIN": "._result", "check_scenario": "._result",
     "check_grid": "htetro_opt.model._lattice",
     "visibility_path": "htetro_opt.model._visibility",

@@ -2,33 +2,19 @@
 
 from __future__ import annotations
 
-import inspect
 import time
 from typing import Callable
 
 import numpy as np
 
-from htetro_opt.errors import ParameterError, PlanningError
-from htetro_opt.solvers.continuous._astar import plan_astar
-from htetro_opt.solvers.continuous._exact import plan_exact
-from htetro_opt.solvers.continuous._prm import plan_prm
-from htetro_opt.solvers.continuous._rrt import plan_rrt
+from htetro_opt.errors import PlanningError
 from htetro_opt.solvers.continuous._result import ContinuousPlan, check_scenario, finish_plan
+from htetro_opt.solvers.continuous._spec import SPEC
 
-__all__ = ["CONTINUOUS_METHODS", "plan_continuous"]
-
-_METHODS = {"exact": plan_exact, "astar": plan_astar, "prm": plan_prm, "rrt": plan_rrt,
-            "ega": "_ega.plan_ega", "ega-paper": "_ega.plan_ega_paper", "nsga2": "_ega.plan_nsga2",
-            "pso": "_pso.plan_pso"}  # the GAs and the PSO load pymoo: imported when asked for
-
-CONTINUOUS_METHODS = tuple(_METHODS)
-"""Method names :func:`plan_continuous` knows: ``"exact"`` (the visibility-graph reference),
-``"astar"``, ``"prm"``, ``"rrt"`` and ``"pso"`` (the baselines of Nazarahari et al. 2019), ``"ega"``
-and ``"ega-paper"`` (its enhanced GA, with our additions or as published) and ``"nsga2"`` (pymoo's
-NSGA-II over the same path bases)."""
+__all__ = ["plan_continuous"]
 
 
-def plan_continuous(scenario, *, method: str | Callable = "exact", **options) -> ContinuousPlan:
+def plan_continuous(scenario, *, method: str | Callable = SPEC.default, **options) -> ContinuousPlan:
     """Plan every robot's path through a continuous scenario (Nazarahari et al. 2019), with one method.
 
     Parameters
@@ -36,7 +22,8 @@ def plan_continuous(scenario, *, method: str | Callable = "exact", **options) ->
     scenario : ContinuousScenario
         A loaded continuous scenario (``ContinuousScenario.from_grid`` converts a grid one).
     method : str or callable, keyword-only
-        One of :data:`CONTINUOUS_METHODS`:
+        A method of the task's spec (:data:`~htetro_opt.solvers.continuous.SPEC`, which lists every
+        method with its options and defaults):
 
         - ``"exact"`` (default): the shortest path of each robot alone, over the visibility graph of
           the free space's corners: the optimum for a point robot; for r > 0 a feasible upper bound,
@@ -64,7 +51,8 @@ def plan_continuous(scenario, *, method: str | Callable = "exact", **options) ->
         (n, 2) array from its start to its goal) or None; it is called once per robot with the
         scenario's :class:`~htetro_opt.model.ContinuousGeometry`.
     **options
-        Keyword options of the method (``grid`` for ``"astar"``; see above for the GAs).
+        Keyword options of the method (``grid`` for ``"astar"``; see above for the GAs), each checked
+        and defaulted by the spec before any work.
 
     Returns
     -------
@@ -101,21 +89,9 @@ def plan_continuous(scenario, *, method: str | Callable = "exact", **options) ->
     scenario = check_scenario(scenario)
     if callable(method):
         return _plan_with(method, scenario, options)
-    if not isinstance(method, str) or method not in _METHODS:
-        raise ParameterError(f"unknown continuous planning method {method!r}: expected one of "
-                             f"{', '.join(CONTINUOUS_METHODS)} or a callable")
-    function = _METHODS[method]
-    if isinstance(function, str):
-        import importlib
-
-        module, name = function.split(".")
-        function = getattr(importlib.import_module(f"htetro_opt.solvers.continuous.{module}"), name)
-    known = [name for name, p in inspect.signature(function).parameters.items() if p.kind is p.KEYWORD_ONLY]
-    unknown = sorted(set(options) - set(known))
-    if unknown:
-        raise ParameterError(f"method {method!r} takes no option {', '.join(map(repr, unknown))}: "
-                             f"its options are {', '.join(known) or 'none'}")
-    return function(scenario, **options)
+    chosen = SPEC.method(method)
+    options = SPEC.check(chosen, options, stage="method")
+    return chosen.load(SPEC.package)(scenario, **chosen.presets, **options)
 
 
 def _plan_with(method: Callable, scenario, options: dict) -> ContinuousPlan:

@@ -15,10 +15,14 @@ import numpy as np
 from htetro_opt._validation import as_rng, check_bool, check_int, derive_seed
 from htetro_opt.errors import ParameterError
 from htetro_opt.model._lattice import check_grid
-from htetro_opt.problems.path_bases import DEFAULT_PATH_WEIGHTS, PathBasesProblem, check_path_weights
+from htetro_opt.problems.names import DEFAULT_PATH_WEIGHTS
+from htetro_opt.problems.path_bases import PathBasesProblem, check_path_weights
 from htetro_opt.solvers.continuous._result import ContinuousPlan, check_scenario, finish_plan
+from htetro_opt.solvers.continuous._spec import SPEC
 
 __all__ = ["plan_ega", "plan_ega_paper", "plan_moea", "plan_nsga2", "MOEA_ALGORITHMS"]
+
+_EGA, _MOEA = SPEC.defaults("ega"), SPEC.defaults("nsga2")  # the task's defaults, declared once in its spec
 
 MOEA_ALGORITHMS = ("nsga2", "nsga3", "smsemoa", "agemoea")
 """pymoo's algorithms :func:`plan_moea` runs over path bases."""
@@ -130,8 +134,9 @@ def _plan_weighted(scenario, *, variant, path, weights, normalise, safety, grid,
                        require_feasible=path == "linear")
 
 
-def plan_ega(scenario, *, path: str = "linear", weights=None, normalise: bool = False, safety: str = "paper",
-             grid: float = 1.0, pop_size: int = 10, max_gen: int = 20, seed=None) -> ContinuousPlan:
+def plan_ega(scenario, *, path: str = _EGA["path"], weights=None, normalise: bool = _EGA["normalise"],
+             safety: str = _EGA["safety"], grid: float = _EGA["grid"], pop_size: int = _EGA["pop_size"],
+             max_gen: int = _EGA["max_gen"], seed=_EGA["seed"]) -> ContinuousPlan:
     """Every robot's path by Nazarahari et al. 2019's enhanced GA with our additions (deletion of
     every child, taut refinement, a finer APF for half the initial paths; see
     :class:`~htetro_opt.algorithms.EnhancedGA`), several robots planned jointly (§4.5).
@@ -186,16 +191,18 @@ def plan_ega(scenario, *, path: str = "linear", weights=None, normalise: bool = 
                           grid=grid, pop_size=pop_size, max_gen=max_gen, seed=seed)
 
 
-def plan_ega_paper(scenario, *, path: str = "linear", weights=None, normalise: bool = False, safety: str = "paper",
-                   grid: float = 1.0, pop_size: int = 10, max_gen: int = 20, seed=None) -> ContinuousPlan:
+def plan_ega_paper(scenario, *, path: str = _EGA["path"], weights=None, normalise: bool = _EGA["normalise"],
+                   safety: str = _EGA["safety"], grid: float = _EGA["grid"], pop_size: int = _EGA["pop_size"],
+                   max_gen: int = _EGA["max_gen"], seed=_EGA["seed"]) -> ContinuousPlan:
     """:func:`plan_ega` with the EGA as published (:meth:`~htetro_opt.algorithms.EnhancedGA.as_published`):
     deletion of one roulette pick per generation, no taut refinement, the APF at step d only."""
     return _plan_weighted(scenario, variant="ega-paper", path=path, weights=weights, normalise=normalise,
                           safety=safety, grid=grid, pop_size=pop_size, max_gen=max_gen, seed=seed)
 
 
-def plan_moea(scenario, *, algorithm: str = "nsga2", path: str = "linear", safety: str = "min", grid: float = 1.0,
-              pop_size: int = 10, max_gen: int = 20, seed=None) -> ContinuousPlan:
+def plan_moea(scenario, *, algorithm: str = "nsga2", path: str = _MOEA["path"], safety: str = _MOEA["safety"],
+              grid: float = _MOEA["grid"], pop_size: int = _MOEA["pop_size"], max_gen: int = _MOEA["max_gen"],
+              seed=_MOEA["seed"]) -> ContinuousPlan:
     """A front of paths minimising (L, S, −safety) by one of pymoo's multi-objective algorithms over
     path bases (:func:`~htetro_opt.algorithms.make_path_algorithm`: APF initial paths, the EGA's
     crossovers and mutations, deletion as the repair, where no objective may rise).
@@ -277,8 +284,8 @@ def _front(problem: PathBasesProblem, pop) -> list:
     return [(F[i], pop[i].X[0]) for i in first]
 
 
-def plan_nsga2(scenario, *, path: str = "linear", safety: str = "min", grid: float = 1.0, pop_size: int = 10,
-               max_gen: int = 20, seed=None) -> ContinuousPlan:
+def plan_nsga2(scenario, *, path: str = _MOEA["path"], safety: str = _MOEA["safety"], grid: float = _MOEA["grid"],
+               pop_size: int = _MOEA["pop_size"], max_gen: int = _MOEA["max_gen"], seed=_MOEA["seed"]) -> ContinuousPlan:
     """:func:`plan_moea` with pymoo's NSGA-II."""
     return plan_moea(scenario, algorithm="nsga2", path=path, safety=safety, grid=grid, pop_size=pop_size,
                      max_gen=max_gen, seed=seed)

@@ -17,6 +17,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
+from htetro_opt._spec import DEFAULT_SEED
 from htetro_opt._validation import as_rng, check_int, check_real
 from htetro_opt.model.continuous import ContinuousGeometry
 from htetro_opt.solvers.continuous._result import ContinuousPlan, check_scenario, finish_plan
@@ -119,7 +120,7 @@ def prm_path(geometry: ContinuousGeometry, start, goal, *, n: int, radius: float
     return path, info
 
 
-def plan_prm(scenario, *, n: int | None = None, radius: float | None = None, seed=None) -> ContinuousPlan:
+def plan_prm(scenario, *, n: int | None = None, radius: float | None = None, seed=DEFAULT_SEED) -> ContinuousPlan:
     """Each robot's PRM path (:func:`prm_path`), alone, with deletion.
 
     ``n`` and ``radius`` default to the paper's for its maps (:data:`PAPER_PRM`), else to

@@ -41,6 +41,9 @@ import numpy as np
 from htetro_opt._validation import as_rng, check_int, derive_seed
 from htetro_opt.model._lattice import check_grid
 from htetro_opt.solvers.continuous._result import ContinuousPlan, check_scenario, finish_plan
+from htetro_opt.solvers.continuous._spec import SPEC
+
+_PSO = SPEC.defaults("pso")  # the task's defaults, declared once in its spec
 
 __all__ = ["pad_path_bases", "keep_feasible_moves", "pso_path", "plan_pso", "INERTIA", "DAMPING", "LEARNING",
            "VELOCITY_STEP"]
@@ -215,7 +218,8 @@ def pso_path(geometry, start, goal, *, pop_size: int = 10, max_gen: int = 20, gr
     return np.vstack([start, best, goal]), {"path_bases": m, "history": history}
 
 
-def plan_pso(scenario, *, pop_size: int = 10, max_gen: int = 20, grid: float = 1.0, seed=None) -> ContinuousPlan:
+def plan_pso(scenario, *, pop_size: int = _PSO["pop_size"], max_gen: int = _PSO["max_gen"], grid: float = _PSO["grid"],
+             seed=_PSO["seed"]) -> ContinuousPlan:
     """Each robot's PSO path (:func:`pso_path`), alone; one ``seed`` drives every robot's run.
 
     ``history``: the first robot's best length per iteration; ``info``: ``pop_size``, ``max_gen``,

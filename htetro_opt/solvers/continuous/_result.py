@@ -7,7 +7,6 @@ geometry and measures it: a method cannot report a length or a feasibility its p
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -18,13 +17,17 @@ from htetro_opt.errors import PlanningError
 from htetro_opt.model.continuous import SAFETY_MARGIN, path_length, path_smoothness, robot_distance
 from htetro_opt.scenarios.loader import ContinuousScenario
 from htetro_opt.scenarios.loader import check_continuous_scenario as check_scenario
+from htetro_opt.solvers._result import Result
 
 __all__ = ["ContinuousPlan", "finish_plan", "check_scenario", "SAFETY_MARGIN"]
 
 
 @dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
-class ContinuousPlan:
+class ContinuousPlan(Result):
     """Paths through a continuous scenario, whatever the method, measured and re-validated.
+
+    ``success``: every robot reached its goal on an obstacle-free path (robots planned alone may still
+    meet: ``conflicts``).
 
     Attributes
     ----------
@@ -94,32 +97,30 @@ class ContinuousPlan:
             "min_clearance": float(clear.min()) if len(clear) else None,
         }
 
-    def as_dict(self) -> dict:
-        """JSON-ready: ``scenario, method, reached, paths, objectives, min_robot_distance, conflicts,
-        runtime_s, info`` (a non-finite number in ``info``, such as §5.3's c_R* = ∞, becomes None:
-        strict JSON has no infinity)."""
+    @property
+    def success(self) -> bool:
+        return self.reached and all(self.feasible)
+
+    @property
+    def message(self) -> str:
+        missed = [k for k, ok in enumerate(self.robots_reached) if not ok]
+        if missed:
+            return f"robot{'s' if len(missed) > 1 else ''} {', '.join(map(str, missed))} did not reach the goal"
+        clash = f"; {len(self.conflicts)} pair(s) of robots closer than {self.safety_distance:g}" if self.conflicts else ""
+        return f"every robot reached its goal, total length {self.length:.3f}{clash}"
+
+    def _fields(self) -> dict:
+        """``scenario, reached, paths, objectives, min_robot_distance, conflicts``."""
         return {
             "scenario": self.scenario,
-            "method": self.method,
             "reached": self.reached,
             "paths": [p.tolist() for p in self.paths],
             "objectives": self.objectives(),
             "min_robot_distance": self.min_robot_distance,
             "conflicts": [list(c) for c in self.conflicts],
-            "runtime_s": float(self.runtime_s),
-            "info": _finite_or_none(dict(self.info)),
         }
 
 
-def _finite_or_none(value):
-    """``value`` with every non-finite float inside its dicts, lists and tuples replaced by None."""
-    if isinstance(value, dict):
-        return {k: _finite_or_none(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_finite_or_none(v) for v in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
 
 
 def finish_plan(scenario: ContinuousScenario, paths: Sequence, *, method: str, began: float,

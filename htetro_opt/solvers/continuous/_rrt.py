@@ -16,17 +16,16 @@ import time
 
 import numpy as np
 
+from htetro_opt._spec import DEFAULT_SEED
 from htetro_opt._validation import as_rng, check_time_limit, derive_seed
 from htetro_opt.errors import ParameterError
 from htetro_opt.solvers.continuous._result import ContinuousPlan, check_scenario, finish_plan
+from htetro_opt.solvers.continuous._spec import RRT_TIME_LIMIT
 
-__all__ = ["rrt_path", "plan_rrt", "STEP", "TIME_LIMIT"]
+__all__ = ["rrt_path", "plan_rrt", "STEP"]
 
 STEP = 2.0
 """The trees' step (the paper's "step size of the B-RRT … set to 2 in all environments")."""
-
-TIME_LIMIT = 120.0
-"""Seconds per robot by default (the paper's terminal condition)."""
 
 INSTALL = "pip install 'htetro-opt[ompl]' (or: pip install ompl)"
 
@@ -51,7 +50,8 @@ def rrt_path(geometry, start, goal, *, time_limit: float | None = None, seed=Non
     start, goal : array_like, shape (2,)
         Feasible points.
     time_limit : float, keyword-only
-        Seconds before giving up (default :data:`TIME_LIMIT`).
+        Seconds before giving up (default: the paper's terminal condition, 120 s, the task spec's
+        ``RRT_TIME_LIMIT``).
     seed : None, int or numpy Generator, keyword-only
         Seeds OMPL's generator (None: fresh entropy).
     delete : bool, keyword-only
@@ -78,7 +78,7 @@ def rrt_path(geometry, start, goal, *, time_limit: float | None = None, seed=Non
     (True, True)
     """
     time_limit = check_time_limit(time_limit, "time_limit")
-    time_limit = TIME_LIMIT if time_limit is None else time_limit
+    time_limit = RRT_TIME_LIMIT if time_limit is None else time_limit
     rng_seed = derive_seed(seed)
     ob, og, ou = _ompl()
     start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
@@ -133,7 +133,7 @@ def rrt_path(geometry, start, goal, *, time_limit: float | None = None, seed=Non
     return path, info
 
 
-def plan_rrt(scenario, *, time_limit: float | None = None, seed=None) -> ContinuousPlan:
+def plan_rrt(scenario, *, time_limit: float | None = None, seed=DEFAULT_SEED) -> ContinuousPlan:
     """Each robot's B-RRT path (:func:`rrt_path`), alone, with deletion; one ``seed`` drives every
     robot's run. ``info``: ``time_limit``, and per robot ``states`` and ``tree_length``.
 
@@ -152,6 +152,6 @@ def plan_rrt(scenario, *, time_limit: float | None = None, seed=None) -> Continu
         path, info = rrt_path(scenario.geometry, start, goal, time_limit=time_limit, seed=rng)
         paths.append(path)
         infos.append(info)
-    info = {"time_limit": TIME_LIMIT if time_limit is None else time_limit,
+    info = {"time_limit": RRT_TIME_LIMIT if time_limit is None else time_limit,
             "states": [i["states"] for i in infos], "tree_length": [i["tree_length"] for i in infos]}
     return finish_plan(scenario, paths, method="rrt", began=began, info=info)

@@ -13,9 +13,9 @@ imports neither pymoo nor DEAP.
 from htetro_opt._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
-    "plan_coverage": "._dispatch", "COVERAGE_METHODS": "._dispatch", "DEFAULT_LAYERS": "._dispatch",
+    "plan_coverage": "._dispatch", "SPEC": "._spec", "DEFAULT_LAYERS": "._spec",
     "CoveragePlan": "._result", "UNCOVERABLE_REASONS": "._result", "RECOVERED_TIME": "._result",
     "parse_layers": "._layers", "Layer": "._layers", "LayerGraph": "._layers",
     "workspace_graph": "._layers", "stripe_graph": "._layers",
-    "stripe_widths": "._stripes", "ENDS": "._stripes", "MOPUP_ORDERS": "._stripes",
+    "stripe_widths": "._stripes", "ENDS": "._spec", "MOPUP_ORDERS": "._spec",
 })

@@ -77,7 +77,7 @@ def tiling_tsp_tokens(lg: LayerGraph, start: int, goal: int | None, *, time_limi
     from htetro_opt.solvers.tiling import tile_workspace
 
     shapes = list(dict.fromkeys(layer.shape for layer in lg.layers))
-    tiles = tile_workspace(lg.workspace, shapes=shapes, time_limit=time_limit)
+    tiles = tile_workspace(lg.workspace, shapes=shapes, time_limit=time_limit).tileset
     poses = tiles.poses
     here = lg.pose(start)
     first = min(range(len(tiles)), key=lambda i: (abs(poses[i].x - here.x) + abs(poses[i].y - here.y), i))

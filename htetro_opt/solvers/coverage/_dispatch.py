@@ -5,30 +5,18 @@ from __future__ import annotations
 import time as _time
 from typing import Callable
 
-from htetro_opt._validation import check_bool, check_int, check_real, check_time_limit
+from htetro_opt._validation import check_real
 from htetro_opt.errors import ParameterError, PlanningError
 from htetro_opt.model.workspace import Workspace, check_workspace
 from htetro_opt.solvers.coverage._baselines import boustrophedon_path, tiling_tsp_tokens
 from htetro_opt.solvers.coverage._layers import LayerGraph, parse_layers
 from htetro_opt.solvers.coverage._result import CoveragePlan, check_end, coverability, finish_coverage
-from htetro_opt.solvers.coverage._stripes import (
-    ENDS,
-    MOPUP_ORDERS,
-    mop_up,
-    plan_stripes,
-    shortest_path,
-    stripe_widths,
-)
+from htetro_opt.solvers.coverage._spec import DEFAULT_LAYERS, SPEC
+from htetro_opt.solvers.coverage._stripes import mop_up, plan_stripes, shortest_path, stripe_widths
 
-__all__ = ["plan_coverage", "COVERAGE_METHODS", "DEFAULT_LAYERS", "auto_start"]
+__all__ = ["plan_coverage", "auto_start"]
 
-COVERAGE_METHODS = ("stripes", "stripes-paper", "boustrophedon", "tiling-tsp")
-"""Method names :func:`plan_coverage` knows: Cheng et al. 2019's stripes with region search (our
-default reading, and the paper's own variant), the one-layer boustrophedon baseline and the tiling +
-TSP baseline."""
-
-DEFAULT_LAYERS = ("O", "vI", "hI")
-"""The paper's best morphology set (Table 2: {O, vI, hI} with 4-row stripes)."""
+_BUILT_IN = ("stripes", "stripes-paper", "boustrophedon", "tiling-tsp")  # planned below; a registered one is called
 
 
 def auto_start(lg: LayerGraph, widths=None):
@@ -53,10 +41,8 @@ def auto_start(lg: LayerGraph, widths=None):
     raise PlanningError(f"no pose of the morphology set ({names}) fits anywhere on the map")
 
 
-def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | Callable = "stripes", stripes=4,
-                  start=None, goal=None, region_columns: int = 4, budget: int = 20_000, clearance: float = 0.0,
-                  time_limit: float | None = None, memo: bool = True, ends: str = "sweep",
-                  mopup: str = "sequenced") -> CoveragePlan:
+def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | Callable = SPEC.default, start=None,
+                  goal=None, **options) -> CoveragePlan:
     """Plan commands that cover every cell the robot can cover, with one method (Cheng et al. 2019).
 
     Parameters
@@ -67,7 +53,8 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
         ``hI`` or ``SHAPE@H``; the paper's best, O, vI, hI, by default. ``"boustrophedon"`` uses
         the first only.
     method : str or callable, keyword-only
-        One of :data:`COVERAGE_METHODS`:
+        A method of the task's spec (:data:`~htetro_opt.solvers.coverage.SPEC`, which lists every
+        method with its options and defaults):
 
         - ``"stripes"`` (default): stripes of rows, each cut into regions of ``region_columns``
           columns, every region searched for its cheapest covering walk, and one auxiliary DAG
@@ -81,14 +68,17 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
           tiles as a TSP and drive through their poses by minimum-command legs.
 
         Or a callable ``method(layer_graph, start_pose, goal_pose)`` returning command tokens (or
-        ids) from the start; its answer is re-validated like the others'.
-    stripes : int, str or sequence of int, keyword-only
-        Stripe widths bottom up (:func:`~htetro_opt.solvers.coverage.stripe_widths`): an int w is
-        ⌊H / w⌋ bands of w rows, the last taking the remainder. Default 4 (the paper's N_str,2).
+        ids) from the start (so is a method registered in the spec); its answer is re-validated like
+        the others'.
     start : Pose or (x, y, shape, heading), optional, keyword-only
         The start; by default the bottom-left pose of the first layer in the first stripe.
     goal : Pose, optional, keyword-only
         Where the plan must end; by default anywhere (a free end).
+    **options
+        The method's options, each checked and defaulted by the spec before any work:
+    stripes : int, str or sequence of int, keyword-only
+        Stripe widths bottom up (:func:`~htetro_opt.solvers.coverage.stripe_widths`): an int w is
+        ⌊H / w⌋ bands of w rows, the last taking the remainder. Default 4 (the paper's N_str,2).
     region_columns : int, keyword-only
         Columns of a region (default 4).
     budget : int, keyword-only
@@ -146,21 +136,24 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
     """
     began = _time.perf_counter()
     check_workspace(workspace)
-    if not callable(method) and method not in COVERAGE_METHODS:
-        raise ParameterError(f"unknown coverage method {method!r}: expected one of {', '.join(COVERAGE_METHODS)} "
-                             "or a callable")
-    for value, name, choices in ((ends, "ends", ENDS), (mopup, "mopup", MOPUP_ORDERS)):
-        if not isinstance(value, str) or value not in choices:
-            raise ParameterError(f"{name} must be one of {', '.join(choices)}, got {value!r}")
+    if callable(method):  # a user's walk: the map's clearance is its only option
+        name = getattr(method, "__name__", type(method).__name__)
+        unknown = sorted(set(options) - {"clearance"})
+        if unknown:
+            raise ParameterError(f"a callable method takes no option {', '.join(map(repr, unknown))}: "
+                                 "its only option is clearance")
+        options = {"clearance": check_real(options.get("clearance", 0.0), "clearance", minimum=0.0)}
+    else:
+        chosen = SPEC.method(method)
+        name, options = chosen.name, SPEC.check(chosen, options, stage="method")
+        if chosen.name not in _BUILT_IN:  # a method registered in the spec is called as a user's walk is
+            method = chosen.load(SPEC.package)
+    clearance = options["clearance"]
     parsed = parse_layers(layers)
     if method == "boustrophedon":
         parsed = parsed[:1]
-    widths = stripe_widths(stripes, workspace.height)
-    region_columns = check_int(region_columns, "region_columns", minimum=1)
-    budget = check_int(budget, "budget", minimum=1)
-    clearance = check_real(clearance, "clearance (cells)", minimum=0.0)
-    time_limit = check_time_limit(time_limit)
-    memo = check_bool(memo, "memo")
+    widths = stripe_widths(options["stripes"], workspace.height) if "stripes" in options else None
+    time_limit = options.get("time_limit")
     lg = LayerGraph(workspace, parsed, clearance=clearance)
     start_node = auto_start(lg, widths) if start is None else check_end(lg, start, "start")
     goal_node = None if goal is None else check_end(lg, goal, "goal")
@@ -168,7 +161,6 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
     if goal_node is not None and not cov.reachable[goal_node]:
         raise PlanningError(f"the goal {tuple(lg.pose(goal_node))} cannot be reached from the start in this "
                             "morphology set")
-    name = method if isinstance(method, str) else getattr(method, "__name__", type(method).__name__)
     if callable(method):
         tokens = method(lg, lg.pose(start_node), None if goal_node is None else lg.pose(goal_node))
         if isinstance(tokens, str):
@@ -182,20 +174,21 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
                                stripes=(), info=info)
     if method in ("stripes", "stripes-paper"):
         deadline = None if time_limit is None else began + time_limit
-        outcome = plan_stripes(lg, cov, start_node, goal_node, widths, region_columns=region_columns, budget=budget,
-                               deadline=deadline, memo=memo, paper=method == "stripes-paper", ends=ends, mopup=mopup)
+        outcome = plan_stripes(lg, cov, start_node, goal_node, widths, region_columns=options["region_columns"],
+                               budget=options["budget"], deadline=deadline, memo=options["memo"],
+                               paper=method == "stripes-paper", ends=options["ends"], mopup=options["mopup"])
         path = outcome.path
         extras = {"stripes_detail": tuple(outcome.stripes), "regions": outcome.regions,
                   "regions_optimal": outcome.regions_optimal, "memo_hits": outcome.memo_hits,
                   "nodes": outcome.nodes, "dag_cost": outcome.dag_cost, "time_limited": outcome.time_limited,
-                  "info": outcome.info, "ends": ends}
+                  "info": outcome.info, "ends": options["ends"]}
         used_stripes = widths
     else:
         path = boustrophedon_path(lg, start_node, cov.reachable)
         extras = {"info": {}}
         used_stripes = ()
     lanes = len(path) - 1
-    added = mop_up(lg, path, cov.coverable, cov.reachable, order=mopup, goal=goal_node)
+    added = mop_up(lg, path, cov.coverable, cov.reachable, order=options["mopup"], goal=goal_node)
     mopup_path = [path[-1]] + added
     tail = []
     if goal_node is not None and mopup_path[-1] != goal_node:

@@ -27,6 +27,7 @@ from htetro_opt.model.coverage import (
 )
 from htetro_opt.model.robot import FOOTPRINTS, Pose, as_pose
 from htetro_opt.model.workspace import Workspace
+from htetro_opt.solvers._result import Result
 from htetro_opt.solvers.coverage._layers import LayerGraph
 
 __all__ = ["CoveragePlan", "Coverability", "coverability", "finish_coverage", "check_end", "UNCOVERABLE_REASONS",
@@ -41,9 +42,10 @@ can reach (a pocket walled off from it)."""
 
 
 @dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
-class CoveragePlan:
+class CoveragePlan(Result):
     """A complete-coverage plan, whatever the method: commands from the start and what they cover
-    (re-validated in the simulator).
+    (re-validated in the simulator). ``success``: every coverable cell is covered (``complete`` asks for
+    every free cell, which a cell no pose of S covers prevents).
 
     Attributes
     ----------
@@ -181,10 +183,21 @@ class CoveragePlan:
         moves = [COMMANDS[int(c)].shift for c in self.commands if COMMANDS[int(c)].kind == "translation"]
         return sum(a != b for a, b in zip(moves[:-1], moves[1:]))
 
-    def as_dict(self) -> dict:
-        """JSON-ready summary (the CLI's ``cover --json`` keys)."""
+    @property
+    def success(self) -> bool:
+        return bool((self.covered | ~self.coverable).all())
+
+    @property
+    def message(self) -> str:
+        missed = int((self.coverable & ~self.covered).sum())
+        if missed:
+            return f"{missed} coverable cells left uncovered ({self.action_cost} commands)"
+        unreachable = f"; {len(self.uncoverable)} free cells no pose of the set covers" if self.uncoverable else ""
+        return f"covered every coverable cell in {self.action_cost} commands{unreachable}"
+
+    def _fields(self) -> dict:
+        """The CLI's ``cover --json`` keys."""
         return {
-            "method": self.method,
             "shapes": list(self.layers),
             "stripes": list(self.stripes),
             "start": self.start.as_dict(),
@@ -214,7 +227,6 @@ class CoveragePlan:
             "stripes_detail": [dict(d) for d in self.stripes_detail],
             "time_limited": self.time_limited,
             "ends": self.ends,
-            "runtime_s": self.runtime_s,
         }
 
 

@@ -62,9 +62,9 @@ from htetro_opt.errors import ParameterError
 from htetro_opt.solvers.coverage._layers import LayerGraph
 from htetro_opt.solvers.coverage._rbt import Region, greedy_walk, search_inserting, search_region
 from htetro_opt.solvers.coverage._result import Coverability
+from htetro_opt.solvers.coverage._spec import ENDS, MOPUP_ORDERS
 
-__all__ = ["stripe_widths", "plan_stripes", "StripeOutcome", "shortest_path", "mop_up", "WINDOW_MARGIN", "CUT_OFFSETS",
-           "ENDS", "MOPUP_ORDERS"]
+__all__ = ["stripe_widths", "plan_stripes", "StripeOutcome", "shortest_path", "mop_up", "WINDOW_MARGIN", "CUT_OFFSETS"]
 
 WINDOW_MARGIN = 3
 """Columns a region may use beyond its own on either side (B2's column)."""
@@ -90,11 +90,6 @@ DROP_PENALTY = 1_000_000
 entry): more than any plan's commands, so the DAG's path leaves as few as it can and only then
 costs least. Without it, a chain that skips targets looks cheaper than it is (coverage_16x7 in one
 7-row stripe, {O, hI}: 71 commands of DAG path, then 15 of mop-up, against 78 covering all)."""
-
-ENDS = ("sweep", "both")
-"""Where a sweep may be left (:func:`plan_stripes`'s ``ends``): at its far end only ("sweep"), or at
-either end ("both": every sweep is in the DAG in both directions)."""
-
 
 def stripe_widths(stripes, height: int, name: str = "stripes") -> tuple[int, ...]:
     """Stripe widths bottom up: an int w gives ⌊H / w⌋ bands of w rows, the remainder added to the
@@ -175,10 +170,6 @@ def _walk_back(pred, source: int, target: int) -> list[int]:
     while path[-1] != source:
         path.append(int(pred[path[-1]]))
     return path[::-1]
-
-
-MOPUP_ORDERS = ("sequenced", "nearest")
-"""How the mop-up orders the cells the sweeps left (:func:`mop_up`)."""
 
 
 def _nearest_first(lg: LayerGraph, path: list[int], target: np.ndarray, reachable: np.ndarray,

@@ -20,12 +20,12 @@ Every method returns a :class:`Plan`, re-validated in the simulator.
 from htetro_opt._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
-    "plan_path": "._dispatch", "PLAN_METHODS": "._dispatch",
+    "plan_path": "._dispatch", "SPEC": "._spec",
     "Plan": "._result", "FrontMember": "._result", "LegResult": "._result",
     "plan_exact": "._exact", "EXACT_METHODS": "._exact",
     "plan_ga": "._ga",
     "plan_max_fitness_sum": "._fitness_sum",
-    "plan_heat": "._heat", "HEAT_ENGINES": "._heat", "BAND_SEEDS": "._heat",
+    "plan_heat": "._heat", "HEAT_ENGINES": "._spec", "BAND_SEEDS": "._spec",
     "replan_heat": "._replan", "HeatRun": "._replan",
-    "solve_heat_field": "._heat_field", "HeatField": "._heat_field", "HEAT_ELEMENTS": "._heat_field",
+    "solve_heat_field": "._heat_field", "HeatField": "._heat_field", "HEAT_ELEMENTS": "._spec",
 })

@@ -2,34 +2,26 @@
 
 from __future__ import annotations
 
-import inspect
 import time as _time
 from typing import Callable, Sequence
 
 import numpy as np
 
-from htetro_opt.errors import ParameterError, PlanningError
+from htetro_opt.errors import PlanningError
 from htetro_opt.model.commands import parse_commands
 from htetro_opt.model.robot import Pose
 from htetro_opt.model.simulate import Simulator
 from htetro_opt.model.workspace import Workspace
-from htetro_opt.solvers.grid_paths._exact import EXACT_METHODS, plan_exact
 from htetro_opt.solvers.grid_paths._result import Plan, finish_plan, prepare
+from htetro_opt.solvers.grid_paths._spec import SPEC
 
-__all__ = ["PLAN_METHODS", "plan_path"]
-
-PLAN_METHODS = ("dijkstra", "astar", "htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea",
-                "heat")
-"""Method names :func:`plan_path` knows: the two exact graph searches (the same optimum), the
-hTetro-GA of Cheng et al. 2020 (with our additions, or as published), four of pymoo's algorithms and
-Do et al. 2021's heat-conduction planner (last); for the GAs, pymoo's algorithms
-over the same command chromosomes."""
+__all__ = ["plan_path"]
 
 _COMPILE = ("commands", "diagonals", "timing", "clearance")
 
 
 def plan_path(workspace: Workspace | Simulator, roadmap: Sequence[Pose], *,
-              method: str | Callable = "dijkstra", **options) -> Plan:
+              method: str | Callable = SPEC.default, **options) -> Plan:
     """Plan the robot's commands through a roadmap of configurations, with one method.
 
     Parameters
@@ -40,9 +32,10 @@ def plan_path(workspace: Workspace | Simulator, roadmap: Sequence[Pose], *,
     roadmap : sequence of Pose
         Start first, goal last, at least two configurations.
     method : str or callable, keyword-only
-        One of :data:`PLAN_METHODS`:
+        A method of the task's spec (:data:`~htetro_opt.solvers.grid_paths.SPEC`, which lists every
+        method with its options and defaults):
 
-        - ``"dijkstra"`` (default), ``"astar"``: the minimum-time plan
+        - ``"dijkstra"`` (default; alias ``"exact"``), ``"astar"``: the minimum-time plan
           (:func:`~htetro_opt.solvers.grid_paths.plan_exact`);
         - ``"htetro-ga"``, ``"htetro-ga-paper"``, ``"nsga2"``, ``"nsga3"``, ``"smsemoa"``,
           ``"agemoea"``: a multi-objective GA over command chromosomes, leg by leg
@@ -57,9 +50,9 @@ def plan_path(workspace: Workspace | Simulator, roadmap: Sequence[Pose], *,
         off the goal gives ``reached=False``, the first unsolved leg as ``failed_leg`` and
         ``info={"returned": its length, "first_invalid": index of its first invalid command or −1}``.
     **options
-        Keyword options of the method (e.g. ``clearance``, ``diagonals``, ``pop_size``, ``seed``);
-        ``commands``, ``diagonals``, ``timing`` and ``clearance`` compile a callable's simulator, the
-        others are passed to it.
+        Keyword options of the method (e.g. ``clearance``, ``diagonals``, ``pop_size``, ``seed``), each
+        checked and defaulted by the spec before any work; ``commands``, ``diagonals``, ``timing`` and
+        ``clearance`` compile a callable's simulator, the others are passed to it.
 
     Returns
     -------
@@ -70,7 +63,8 @@ def plan_path(workspace: Workspace | Simulator, roadmap: Sequence[Pose], *,
     Raises
     ------
     ParameterError
-        On an unknown method, or an option the named method does not take.
+        On an unknown method, an option the named method does not take (naming its options), or a bad
+        option value.
     PlanningError
         If the roadmap has fewer than two configurations, or a callable returns something that is
         not a sequence of commands.
@@ -91,31 +85,9 @@ def plan_path(workspace: Workspace | Simulator, roadmap: Sequence[Pose], *,
     """
     if callable(method):
         return _plan_with(method, workspace, roadmap, options)
-    if method in EXACT_METHODS:
-        _check_options(plan_exact, options, method)
-        return plan_exact(workspace, roadmap, method=method, **options)
-    if method == "heat":
-        from htetro_opt.solvers.grid_paths._heat import plan_heat
-
-        _check_options(plan_heat, options, method)
-        return plan_heat(workspace, roadmap, **options)
-    if method in PLAN_METHODS:
-        from htetro_opt.solvers.grid_paths._ga import plan_ga  # pymoo's algorithms load only when used
-
-        _check_options(plan_ga, options, method)
-        return plan_ga(workspace, roadmap, algorithm=method, **options)
-    raise ParameterError(f"unknown planning method {method!r}: expected one of {', '.join(PLAN_METHODS)}, "
-                         "heat or a callable")
-
-
-def _check_options(function: Callable, options: dict, method: str) -> None:
-    """Refuse options the method does not take, naming them (rather than a bare TypeError)."""
-    known = [name for name, p in inspect.signature(function).parameters.items()
-             if p.kind is p.KEYWORD_ONLY and name not in ("method", "algorithm")]
-    unknown = sorted(set(options) - set(known))
-    if unknown:
-        raise ParameterError(f"method {method!r} takes no option {', '.join(map(repr, unknown))}: "
-                             f"its options are {', '.join(known)}")
+    chosen = SPEC.method(method)
+    options = SPEC.check(chosen, options, stage="method")
+    return chosen.load(SPEC.package)(workspace, roadmap, **chosen.presets, **options)
 
 
 def _as_commands(commands, name: str) -> np.ndarray:

@@ -56,11 +56,8 @@ from htetro_opt.model.simulate import Simulator, check_memory, size_text
 from htetro_opt.model.workspace import Workspace
 # The programme's kernels live among the operators: the hTetro-GA's balanced polish solves it over windows.
 from htetro_opt.operators.commands._sum_dp import first_arrivals, min_bracket, usable_table
-from htetro_opt.problems.command_path import (
-    FITNESS_NAMES,
-    SAFETY_COEFFICIENT,
-    CommandPathProblem,
-)
+from htetro_opt.problems.command_path import SAFETY_COEFFICIENT, CommandPathProblem
+from htetro_opt.problems.names import FITNESS_NAMES
 from htetro_opt.solvers.grid_paths._exact import plan_exact
 from htetro_opt.solvers.grid_paths._ga import _max_length
 from htetro_opt.solvers.grid_paths._result import Plan, check_map, finish_plan, prepare

@@ -37,6 +37,7 @@ from htetro_opt.model.workspace import Workspace, grid_distance
 from htetro_opt.problems.command_path import CommandPathProblem
 from htetro_opt.solvers.grid_paths._exact import plan_exact
 from htetro_opt.solvers.grid_paths._result import FrontMember, LegResult, Plan, finish_plan, prepare
+from htetro_opt.solvers.grid_paths._spec import GA_PATIENCE, SPEC
 
 __all__ = ["plan_ga", "default_max_length", "DEFAULT_MAX_LENGTH"]
 
@@ -49,7 +50,7 @@ def _members(problem: CommandPathProblem, X: np.ndarray, F: np.ndarray) -> list[
             for i in range(len(X))]
 
 
-_PATIENCE = {"best": 100, "hypervolume": 20}  # plan_ga's patience by convergence measure (measured, see docstring)
+_DEFAULTS = SPEC.defaults("htetro-ga")  # the task's defaults, declared once in its spec
 
 DEFAULT_MAX_LENGTH = 100
 """The paper's l_p,max, the least default of :func:`plan_ga`'s ``max_length``."""
@@ -127,12 +128,12 @@ def plan_ga(
     roadmap: Sequence[Pose],
     *,
     algorithm: str = "htetro-ga",
-    pop_size: int = 50,
-    max_gen: int = 1000,
+    pop_size: int = _DEFAULTS["pop_size"],
+    max_gen: int = _DEFAULTS["max_gen"],
     patience: int | None = None,
-    convergence: str = "best",
+    convergence: str = _DEFAULTS["convergence"],
     max_length: int | None = None,
-    seed=0,
+    seed=_DEFAULTS["seed"],
     sampling_weights: Mapping[str, float] | None = None,
     commands: Sequence[str] | None = None,
     timing: Timing | None = None,
@@ -142,8 +143,8 @@ def plan_ga(
     hv_reference=None,
     replan_window: int | None = None,
     replan_members: int | None = None,
-    seed_exact: bool = False,
-    pick: str = "balanced",
+    seed_exact: bool = _DEFAULTS["seed_exact"],
+    pick: str = _DEFAULTS["pick"],
     reach_share: float | None = None,
     conservative: bool | None = None,
     reach_patience: int | None = None,
@@ -273,7 +274,7 @@ def plan_ga(
     max_gen = check_int(max_gen, "max_gen", minimum=1)
     if not isinstance(convergence, str) or convergence not in CONVERGENCE_MEASURES:
         raise ParameterError(f"convergence must be one of {', '.join(CONVERGENCE_MEASURES)}, got {convergence!r}")
-    patience = check_int(_PATIENCE[convergence] if patience is None else patience, "patience", minimum=1)
+    patience = check_int(GA_PATIENCE[convergence] if patience is None else patience, "patience", minimum=1)
     max_length = check_int(max_length, "max_length", minimum=1, allow_none=True)
     progress = check_progress(progress)
     reference = None if hv_reference is None else _check_reference(hv_reference)

@@ -68,16 +68,11 @@ from htetro_opt.model.sweeps import sweep_tables
 from htetro_opt.model.workspace import Workspace, describe_cells, grid_distance
 from htetro_opt.problems.heat_costs import check_heat_weights, default_t_max, heat_fitness, safety_pattern
 from htetro_opt.solvers.grid_paths._exact import _GRAPH_BYTES, _check_memory, _Graph
-from htetro_opt.solvers.grid_paths._heat_field import HEAT_ELEMENTS, solve_heat_field
+from htetro_opt.solvers.grid_paths._heat_field import solve_heat_field
 from htetro_opt.solvers.grid_paths._result import Plan, check_map, check_roadmap, finish_plan, prepare
+from htetro_opt.solvers.grid_paths._spec import BAND_SEEDS, HEAT_ELEMENTS, HEAT_ENGINES
 
-__all__ = ["plan_heat", "HEAT_ENGINES", "BAND_SEEDS", "BAND_AUTO_POSES", "BAND_AUTO_RADIUS"]
-
-HEAT_ENGINES = ("dijkstra", "wavefront")
-"""Searches of a leg: scipy's Dijkstra, or the paper's waves relaxed to convergence (same optimum)."""
-
-BAND_SEEDS = ("ascent", "grid_distance")
-"""Lines a band follows: the field's steepest-ascent line, or a shortest cell path (an ablation)."""
+__all__ = ["plan_heat", "BAND_AUTO_POSES", "BAND_AUTO_RADIUS"]
 
 BAND_AUTO_POSES = 4_000_000
 """``band="auto"`` searches the whole pose graph up to this many poses, and a band above."""

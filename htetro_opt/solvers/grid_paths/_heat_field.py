@@ -45,11 +45,9 @@ from scipy.sparse.linalg import spsolve
 from htetro_opt._validation import check_bool, check_real
 from htetro_opt.errors import ConfigurationError, ParameterError
 from htetro_opt.model.workspace import check_workspace
+from htetro_opt.solvers.grid_paths._spec import HEAT_ELEMENTS
 
-__all__ = ["DIRECT_MAX_DOFS", "HEAT_ELEMENTS", "HEAT_SOLVERS", "HeatField", "q1_element_matrix", "solve_heat_field"]
-
-HEAT_ELEMENTS = ("q1", "p0")
-"""Elements :func:`solve_heat_field` knows: the bilinear quadrilateral (the paper's) and DG0 (ours)."""
+__all__ = ["DIRECT_MAX_DOFS", "HEAT_SOLVERS", "HeatField", "q1_element_matrix", "solve_heat_field"]
 
 HEAT_SOLVERS = ("auto", "direct", "amg")
 """Linear solvers: SuperLU, pyamg's Ruge–Stüben as a CG preconditioner, or the choice by size."""

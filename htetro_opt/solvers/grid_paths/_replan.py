@@ -25,7 +25,7 @@ from htetro_opt.model.workspace import Workspace
 from htetro_opt.problems.heat_costs import heat_fitness
 from htetro_opt.scenarios.loader import ContinuousScenario, Scenario
 from htetro_opt.solvers.grid_paths._heat import plan_heat
-from htetro_opt.solvers.grid_paths._result import check_roadmap
+from htetro_opt.solvers.grid_paths._result import Plan, check_roadmap
 
 __all__ = ["HeatRun", "replan_heat"]
 
@@ -92,6 +92,17 @@ class HeatRun:
             "runtime_s": round(self.runtime_s, 6),
             **self.info,
         }
+
+    def as_plan(self) -> Plan:
+        """The run as a :class:`~htetro_opt.solvers.grid_paths.Plan` of its executed commands (method
+        ``"heat (replanning)"``), its ``info`` holding the run's fitness, weights, t_max, sensor range,
+        plans and replans (and the last plan's fields, when kept)."""
+        info = {"fitness": dict(self.fitness), "weights": self.info["weights"], "t_max": self.info["t_max"],
+                "sensor_range": self.info["sensor_range"], "plans": int(self.plans),
+                "replans": self.as_dict()["replans"], "fields": self.fields}
+        return Plan(method="heat (replanning)", commands=self.executed, reached=self.reached, time=self.time,
+                    poses=self.poses, leg_ends=(len(self.executed),) if self.reached else (),
+                    failed_leg=-1 if self.reached else 0, runtime_s=self.runtime_s, info=info)
 
 
 def _command_reach(simulator: Simulator) -> float:

@@ -20,7 +20,8 @@ from htetro_opt.model.commands import COMMANDS
 from htetro_opt.model.robot import Pose, as_pose
 from htetro_opt.model.simulate import Simulator
 from htetro_opt.model.workspace import Workspace, check_workspace
-from htetro_opt.problems.command_path import FITNESS_NAMES
+from htetro_opt.problems.names import FITNESS_NAMES
+from htetro_opt.solvers._result import Result
 
 __all__ = ["Plan", "FrontMember", "LegResult", "finish_plan", "prepare", "check_roadmap", "check_map"]
 
@@ -74,9 +75,9 @@ class LegResult:
 
 
 @dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
-class Plan:
+class Plan(Result):
     """A plan through a roadmap, whatever the method: global command ids from the start, and what
-    they achieve (re-validated in the simulator).
+    they achieve (re-validated in the simulator). ``success`` is ``reached``.
 
     Attributes
     ----------
@@ -118,6 +119,26 @@ class Plan:
     @property
     def tokens(self) -> list[str]:
         return [COMMANDS[int(c)].token for c in self.commands]
+
+    @property
+    def success(self) -> bool:
+        return bool(self.reached)
+
+    @property
+    def message(self) -> str:
+        legs = len(self.leg_ends) + (0 if self.reached else 1)
+        if self.reached:
+            return f"reached the goal: {len(self.commands)} commands, {self.time:g} s"
+        why = "the GA's final population holds no member reaching it" if self.legs else "it has no path"
+        return f"goal not reached: leg {self.failed_leg + 1} was not solved ({why}); the plan holds the legs before it"
+
+    def _fields(self) -> dict:
+        out = {"reached": bool(self.reached), "commands": self.tokens, "time": float(self.time),
+               "objectives": self.objectives(), "leg_ends": list(self.leg_ends), "failed_leg": self.failed_leg}
+        if self.legs:
+            out["reach_generation"] = self.reach_generation
+            out["generations"] = sum(leg.generations for leg in self.legs)
+        return out
 
     @property
     def reach_generation(self) -> int | None:

@@ -1,7 +1,6 @@
 """Waypoint sequencing (Le et al. 2018): order a tileset's waypoints as an open path of least eq.-2 cost.
 
-:func:`sequence_waypoints` runs one method (``method=``, a name of :data:`SEQUENCE_METHODS` or a
-callable) and returns a :class:`SequenceResult` re-priced on the instance. The methods, each also a
+:func:`sequence_waypoints` runs one method (``method=``, a method of :data:`SPEC` or a callable) and returns a :class:`SequenceResult` re-priced on the instance. The methods, each also a
 function of its own:
 
 - ``exact`` (:func:`solve_exact`): the CP-SAT optimum with a proof, up to 40 waypoints;
@@ -30,11 +29,11 @@ methods ask for ``from_tileset(..., dense=True)``.
 from htetro_opt._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
-    "sequence_waypoints": "._dispatch", "SequenceResult": "._dispatch", "SEQUENCE_METHODS": "._dispatch",
-    "EXACT_AUTO_LIMIT": "._dispatch", "ASYMMETRIC_METHODS": "._dispatch",
+    "sequence_waypoints": "._dispatch", "SequenceResult": "._dispatch", "SPEC": "._spec",
+    "EXACT_AUTO_LIMIT": "._spec", "ASYMMETRIC_METHODS": "._dispatch",
     "auto_method": "._dispatch", "default_time_limit": "._budgets", "TIME_LIMIT_TEXT": "._budgets",
-    "solve_exact": "._exact", "held_karp": "._exact", "EXACT_MAX_SIZE": "._exact",
-    "solve_ortools": "._ortools", "ortools_time_limit": "._ortools", "FIRST_SOLUTIONS": "._ortools",
+    "solve_exact": "._exact", "held_karp": "._exact", "EXACT_MAX_SIZE": "._spec",
+    "solve_ortools": "._ortools", "ortools_time_limit": "._ortools", "FIRST_SOLUTIONS": "._spec",
     "solve_local": "._local", "nearest_neighbour": "._local", "nearest_neighbour_paths": "._local",
     "two_opt": "._local", "or_opt": "._local", "improve": "._local", "improve_batch": "._local",
     "double_bridge": "._local",
@@ -42,5 +41,5 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "solve_zigzag": "._baselines", "solve_spiral": "._baselines", "solve_greedy": "._baselines",
     "PATTERN_VARIANTS": "._baselines",
     "solve_ils": "._ils", "ils_kicks": "._ils", "ILS_NEIGHBOURS": "._ils", "ILS_KICK_SPAN": "._ils",
-    "solve_fast_tsp": "._backends", "solve_lkh": "._backends", "FAST_TSP_CANDIDATES": "._backends",
+    "solve_fast_tsp": "._backends", "solve_lkh": "._backends", "FAST_TSP_CANDIDATES": "._spec",
 })

@@ -42,17 +42,15 @@ from htetro_opt._validation import check_int, check_seed, check_time_limit
 from htetro_opt.errors import ParameterError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance
 from htetro_opt.solvers.sequencing._budgets import default_time_limit
+from htetro_opt.solvers.sequencing._spec import FAST_TSP_CANDIDATES
 
-__all__ = ["FAST_TSP_RESOLUTION", "LKH_RESOLUTION", "FAST_TSP_CANDIDATES", "solve_fast_tsp", "solve_lkh"]
+__all__ = ["FAST_TSP_RESOLUTION", "LKH_RESOLUTION", "solve_fast_tsp", "solve_lkh"]
 
 FAST_TSP_RESOLUTION = 2**16 - 1
 """fast-tsp's largest integer cost (it stores costs as uint16)."""
 
 LKH_RESOLUTION = 10**6
 """The largest integer cost handed to LKH (it multiplies costs by 100 in 32-bit integers)."""
-
-FAST_TSP_CANDIDATES = ("auto", "nearest", "alpha")
-"""fast-tsp's neighbour lists (its ``candidates``): see :func:`solve_fast_tsp`."""
 
 _INSTALL = {
     "fast-tsp": ("fast_tsp", "the fast-tsp package (MIT licence): pip install \"htetro-opt[fast-tsp]\""),

@@ -38,7 +38,7 @@ def default_time_limit(method: str, n: int) -> float | None:
         base, per, cap = _LINEAR[method]
         return round(min(cap, base + n / per), 6)
     if method == "exact":
-        from htetro_opt.solvers.sequencing._exact import EXACT_TIME_LIMIT
+        from htetro_opt.solvers.sequencing._spec import EXACT_TIME_LIMIT
 
         return EXACT_TIME_LIMIT
     if method == "ortools":

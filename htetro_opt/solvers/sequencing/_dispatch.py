@@ -19,11 +19,11 @@ from __future__ import annotations
 import inspect
 import time
 from dataclasses import dataclass, field
-from importlib import import_module
 
 import numpy as np
 
 from htetro_opt._progress import check_progress
+from htetro_opt._spec import DEFAULT_SEED
 from htetro_opt._validation import check_seed, check_time_limit
 from htetro_opt.errors import ParameterError
 from htetro_opt.problems.waypoint_sequencing import (
@@ -31,53 +31,35 @@ from htetro_opt.problems.waypoint_sequencing import (
     check_instance,
     reduce_to_open_path,
 )
+from htetro_opt.solvers._result import Result
+from htetro_opt.solvers.sequencing._spec import EXACT_AUTO_LIMIT, SPEC
 
 __all__ = [
     "ASYMMETRIC_METHODS",
-    "EXACT_AUTO_LIMIT",
-    "SEQUENCE_METHODS",
     "SequenceResult",
     "auto_method",
     "sequence_waypoints",
 ]
 
-# name → (module, function, preset options, capabilities): "asymmetric" (asymmetric costs allowed),
-# "tours" (closed tours and fixed ends taken natively), "geometry" (needs the tiles' block cells),
-# "implicit" (sequences an instance without a cost matrix, SequencingInstance.implicit)
-_METHODS = {
-    "exact": ("._exact", "solve_exact", {}, {"asymmetric"}),
-    "ortools": ("._ortools", "solve_ortools", {}, {"asymmetric"}),
-    "local": ("._local", "solve_local", {}, set()),
-    "ils": ("._ils", "solve_ils", {}, {"tours", "implicit"}),
-    # the memetic GA finds its best within a few generations; 50 more without improvement suffice
-    "ga": ("._ga", "solve_ga", {"memetic": True, "patience": 50}, set()),
-    "ga-plain": ("._ga", "solve_ga", {"memetic": False}, set()),
-    "zigzag": ("._baselines", "solve_zigzag", {"rows": 1}, {"asymmetric", "geometry"}),
-    "zigzag2": ("._baselines", "solve_zigzag", {"rows": 2}, {"asymmetric", "geometry"}),
-    "spiral": ("._baselines", "solve_spiral", {"rows": 1}, {"asymmetric", "geometry"}),
-    "spiral2": ("._baselines", "solve_spiral", {"rows": 2}, {"asymmetric", "geometry"}),
-    "greedy": ("._baselines", "solve_greedy", {}, {"asymmetric"}),
-    "fast-tsp": ("._backends", "solve_fast_tsp", {}, {"tours"}),
-    "lkh": ("._backends", "solve_lkh", {}, {"asymmetric", "tours"}),
-}
 
-SEQUENCE_METHODS: tuple[str, ...] = ("auto",) + tuple(_METHODS)
-"""Method names: ``auto`` (the default), then every method."""
+def _asymmetric() -> tuple[str, ...]:
+    return tuple(name for name, m in SPEC.methods.items() if "asymmetric" in m.capabilities and name != "auto")
 
-ASYMMETRIC_METHODS: tuple[str, ...] = tuple(name for name, entry in _METHODS.items() if "asymmetric" in entry[3])
-"""The methods that accept an asymmetric cost matrix (the others assume ``cost[i, j] == cost[j, i]``)."""
 
-EXACT_AUTO_LIMIT = 40
-"""``auto`` proves the optimum with the exact solver up to this many waypoints (a closed tour counts
-one more, the copy of its first waypoint); beyond, see :func:`auto_method`."""
+def __getattr__(name: str):
+    if name == "ASYMMETRIC_METHODS":  # read from the spec when asked: a registered method counts too
+        return _asymmetric()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 @dataclass(frozen=True, eq=False)
-class SequenceResult:
+class SequenceResult(Result):
     """A method's order, re-priced on the instance.
 
     ``method`` names the method (``"auto (exact)"`` when ``auto`` chose it); ``order`` holds
-    waypoint indices, ``tiles`` the same order as tile labels; ``info`` the method's extras.
+    waypoint indices, ``tiles`` the same order as tile labels; ``info`` the method's extras
+    (``optimal`` when the order is proven optimal). Every order visits every waypoint once, so
+    ``success`` is always True; ``message`` says whether the order is proven optimal.
     """
 
     method: str
@@ -87,9 +69,17 @@ class SequenceResult:
     runtime_s: float
     info: dict = field(default_factory=dict)
 
-    def as_dict(self) -> dict:
-        return {"method": self.method, "order": self.tiles, "cost": self.cost,
-                "runtime_s": round(self.runtime_s, 6), **self.info}
+    @property
+    def success(self) -> bool:
+        return True
+
+    @property
+    def message(self) -> str:
+        proof = "proven optimal" if self.info.get("optimal") else "not proven optimal"
+        return f"{len(self.tiles)} waypoints, cost {self.cost:.6g} ({proof})"
+
+    def _fields(self) -> dict:
+        return {"order": [int(t) for t in self.tiles], "cost": float(self.cost)}
 
 
 def _takes(function, keyword: str) -> bool:
@@ -131,30 +121,27 @@ def auto_method(instance: SequencingInstance) -> str:
     return "ils"
 
 
-def _resolve(method, instance: SequencingInstance) -> tuple[str, object, dict, set]:
-    if callable(method):
-        return getattr(method, "__name__", type(method).__name__), method, {}, {"asymmetric", "geometry"}
-    if method == "auto":
-        method = auto_method(instance)
-    if not isinstance(method, str) or method not in _METHODS:
-        raise ParameterError(f"unknown sequencing method {method!r}: expected one of {', '.join(SEQUENCE_METHODS)} "
-                             "or a callable")
-    module, function, preset, capabilities = _METHODS[method]
+def _resolve(method, instance: SequencingInstance):
+    """(the name the result carries, the Method run, the name it runs as) of ``method`` on ``instance``,
+    its capabilities checked against the instance before it runs."""
+    chosen = SPEC.method(method)
+    run = SPEC.method(auto_method(instance)) if chosen.name == "auto" else chosen
+    capabilities = run.capabilities
     if instance.implicit and "implicit" not in capabilities:
-        raise ParameterError(f"method {method!r} needs the cost matrix, and this instance of {instance.n} waypoints "
+        raise ParameterError(f"method {run.name!r} needs the cost matrix, and this instance of {instance.n} waypoints "
                              "keeps its eq.-2 costs implicit (above DENSE_LIMIT waypoints): use ils or auto, or "
                              "SequencingInstance.from_tileset(..., dense=True)")
     if "geometry" in capabilities and not instance.has_geometry:
-        raise ParameterError(f"method {method!r} scans the tiles' positions, and this instance has no tile geometry "
+        raise ParameterError(f"method {run.name!r} scans the tiles' positions, and this instance has no tile geometry "
                              "(a plain cost matrix): use another method, e.g. auto")
     if "asymmetric" not in capabilities and not instance.symmetric:
-        raise ParameterError(f"method {method!r} assumes a symmetric cost matrix, and this one is not: use one of "
-                             f"{', '.join(ASYMMETRIC_METHODS)} (or auto)")
-    return method, getattr(import_module(module, __package__), function), preset, capabilities
+        raise ParameterError(f"method {run.name!r} assumes a symmetric cost matrix, and this one is not: use one of "
+                             f"{', '.join(_asymmetric())} (or auto)")
+    label = run.name if chosen is run else f"{chosen.name} ({run.name})"
+    return label, chosen, run
 
 
-def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, time_limit: float | None = None,
-                       progress=None, **options) -> SequenceResult:
+def sequence_waypoints(instance: SequencingInstance, *, method="auto", **options) -> SequenceResult:
     """Order the waypoints of an instance with one method.
 
     Parameters
@@ -162,27 +149,25 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, t
     instance : SequencingInstance
         Costs, block cells and start.
     method : str or callable, keyword-only
-        One of :data:`SEQUENCE_METHODS`. ``auto`` is the exact solver up to
-        :data:`EXACT_AUTO_LIMIT` waypoints and, beyond, the compiled iterated local search ``ils``
-        (ortools for asymmetric costs): :func:`auto_method`. A callable
-        ``method(instance, *, seed, time_limit, **options)`` returning ``(order, info)`` is run the
-        same way (given the open-path reduction of a closed tour or a fixed end).
-    seed : None, int or numpy.random.Generator, keyword-only
-        Seed of the stochastic methods (the deterministic ones and ortools, which has no seed,
-        check it and ignore it): an int or a Generator reproduces a run, None draws fresh entropy.
-    time_limit : float, optional, keyword-only
-        Wall-clock budget in seconds for the methods that take one (exact, ortools, ga, ga-plain,
-        local, greedy, fast-tsp; lkh refuses one): a positive, finite number; None: the method's
-        default, sized to the instance (:func:`default_time_limit`: exact 60 s; ortools 1 s up to 20
-        waypoints, rising to 30 s at 40; ga, ga-plain 10 s + 1 s per 50 waypoints, at most 60 s;
-        greedy 10 s + 1 s per 100 waypoints, at most 30 s; local 10 s + 1 s per 100 waypoints, at
-        most 120 s; fast-tsp 0.5 s + 1 s per 400 waypoints, at most 30 s; ils, whose budget is
-        its kicks, a safety cap of 60 s + 1 s per 20 waypoints, at most 600 s).
-    progress : callable, optional, keyword-only
-        ``progress(done, total, note)`` from the methods that report (ga, ga-plain, greedy, local,
-        ortools; a callable method that takes a ``progress`` keyword), see :mod:`htetro_opt._progress`.
+        A method of the task's spec (:data:`~htetro_opt.solvers.sequencing.SPEC`, which lists every
+        method with its options, defaults and capabilities). ``auto`` is the exact solver up to
+        :data:`~htetro_opt.solvers.sequencing.EXACT_AUTO_LIMIT` waypoints and, beyond, the compiled
+        iterated local search ``ils`` (ortools for asymmetric costs): :func:`auto_method`; it hands its
+        ``seed``, ``time_limit`` and ``progress`` to the method it runs, as far as that one takes them. A
+        callable ``method(instance, *, seed, time_limit, **options)`` returning ``(order, info)`` is run
+        the same way (given the open-path reduction of a closed tour or a fixed end, and ``progress`` if
+        it takes that keyword).
     **options
-        Passed to the method (e.g. ``pop_size`` for ``ga``, ``iterations`` for ``greedy``).
+        The method's options, each checked and defaulted by the spec before any work, among them:
+
+        - ``seed`` (the stochastic methods: auto, ils, local, ga, ga-plain, greedy): None draws fresh
+          entropy, an int or a Generator reproduces a run; default 0;
+        - ``time_limit`` (the methods that take one; not lkh, nor the instant patterns): seconds, a
+          positive finite number; None: the method's default, sized to the instance
+          (:func:`~htetro_opt.solvers.sequencing.default_time_limit`);
+        - ``progress``: ``progress(done, total, note)`` from the methods that report (ga, ga-plain,
+          greedy, local, ortools), see :mod:`htetro_opt._progress`;
+        - the methods' own (``pop_size`` for ``ga``, ``iterations`` for ``greedy``, ``runs`` for ``lkh``, …).
 
     Returns
     -------
@@ -191,10 +176,10 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, t
     Raises
     ------
     ParameterError
-        On an unknown method or option value (an infinite ``time_limit`` among them), an
-        ``instance`` that is not a :class:`SequencingInstance`, an asymmetric matrix for a method
-        that assumes symmetric costs (see :data:`ASYMMETRIC_METHODS`), a plain matrix for a pattern
-        baseline, or a method whose optional package is missing.
+        On an unknown method or option (naming the method's options), a bad option value (an infinite
+        ``time_limit`` among them), an ``instance`` that is not a :class:`SequencingInstance`, an
+        asymmetric matrix for a method that assumes symmetric costs (see :data:`ASYMMETRIC_METHODS`), a
+        plain matrix for a pattern baseline, or a method whose optional package is missing.
 
     Examples
     --------
@@ -205,19 +190,28 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, t
     ([3, 2, 1], 2.0)
     """
     check_instance(instance)
-    time_limit = check_time_limit(time_limit)
-    seed = check_seed(seed)
-    progress = check_progress(progress)
-    name, function, preset, capabilities = _resolve(method, instance)
-    if progress is not None and _takes(function, "progress"):
-        options = {**options, "progress": progress}
+    if callable(method):
+        label = getattr(method, "__name__", type(method).__name__)
+        call = dict(options)
+        call["seed"] = check_seed(call.get("seed", DEFAULT_SEED))
+        call["time_limit"] = check_time_limit(call.get("time_limit"))
+        progress = check_progress(call.pop("progress", None))
+        if progress is not None and _takes(method, "progress"):
+            call["progress"] = progress
+        function, capabilities = method, {"asymmetric", "geometry"}
+    else:
+        label, chosen, run = _resolve(method, instance)
+        call = SPEC.check(chosen, options, stage="method")
+        if run is not chosen:  # auto: its options, to the method it runs as far as that one takes them
+            call = SPEC.check(run, {k: v for k, v in call.items() if run.takes(k)}, stage="method")
+        function, capabilities, call = run.load(SPEC.package), run.capabilities, {**run.presets, **call}
     reduction = None
     solved = instance
     if (instance.closed or instance.end is not None) and "tours" not in capabilities:
         reduction = reduce_to_open_path(instance)
         solved = reduction.instance
     began = time.perf_counter()
-    order, info = function(solved, seed=seed, time_limit=time_limit, **{**preset, **options})
+    order, info = function(solved, **call)
     runtime = time.perf_counter() - began
     info = dict(info)
     if reduction is not None:
@@ -225,5 +219,4 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", seed=0, t
         if "bound" in info:  # a bound on the reduction's optimum, which exceeds the instance's by the offset
             info["bound"] = float(info["bound"] - reduction.offset)
     order = instance.check_order(order)
-    label = name if method == name or callable(method) else f"{method} ({name})"
     return SequenceResult(label, order, instance.tile_order(order), instance.path_cost(order), runtime, info)

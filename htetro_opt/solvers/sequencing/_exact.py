@@ -29,21 +29,14 @@ from htetro_opt._validation import check_int, check_time_limit, derive_seed
 from htetro_opt.errors import ParameterError, PlanningError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance, path_cost
 from htetro_opt.solvers.sequencing._local import _check_square, nearest_neighbour_paths
+from htetro_opt.solvers.sequencing._spec import EXACT_MAX_SIZE, EXACT_TIME_LIMIT
 
 __all__ = [
     "COST_RESOLUTION",
-    "EXACT_MAX_SIZE",
-    "EXACT_TIME_LIMIT",
     "HELD_KARP_MAX_SIZE",
     "held_karp",
     "solve_exact",
 ]
-
-EXACT_MAX_SIZE = 40
-"""Default largest instance :func:`solve_exact` accepts (its ``max_size``)."""
-
-EXACT_TIME_LIMIT = 60.0
-"""Default wall-clock budget of :func:`solve_exact`, in seconds."""
 
 COST_RESOLUTION = 1e9
 """CP-SAT needs integer costs: the largest absolute cost becomes this integer, every other cost is

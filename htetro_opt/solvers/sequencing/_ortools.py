@@ -33,8 +33,9 @@ from htetro_opt._progress import check_progress, report
 from htetro_opt._validation import check_real, check_seed, check_time_limit
 from htetro_opt.errors import ParameterError, PlanningError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance
+from htetro_opt.solvers.sequencing._spec import FIRST_SOLUTIONS
 
-__all__ = ["FIRST_SOLUTIONS", "ORTOOLS_COST_RESOLUTION", "ortools_time_limit", "solve_ortools"]
+__all__ = ["ORTOOLS_COST_RESOLUTION", "ortools_time_limit", "solve_ortools"]
 
 ORTOOLS_COST_RESOLUTION = 1e9
 """Default cost scale: the largest absolute cost becomes this integer (as in the exact solver)."""
@@ -42,17 +43,6 @@ ORTOOLS_COST_RESOLUTION = 1e9
 _MAX_PATH_UNITS = 2**53
 """Scaled path costs must stay exact in a double (guided local search prices its penalties in
 floating point) and far inside int64."""
-
-FIRST_SOLUTIONS = (
-    "AUTOMATIC", "PATH_CHEAPEST_ARC", "PATH_MOST_CONSTRAINED_ARC", "SAVINGS", "PARALLEL_SAVINGS",
-    "PARALLEL_CHEAPEST_INSERTION", "SEQUENTIAL_CHEAPEST_INSERTION", "LOCAL_CHEAPEST_INSERTION",
-    "LOCAL_CHEAPEST_COST_INSERTION", "GLOBAL_CHEAPEST_ARC", "LOCAL_CHEAPEST_ARC", "FIRST_UNBOUND_MIN_VALUE",
-)
-"""OR-Tools' first-solution strategies accepted as ``first_solution``. Left out: ``SWEEP`` (needs
-waypoint coordinates, the model is invalid without them), and ``CHRISTOFIDES`` and
-``BEST_INSERTION``, which with OR-Tools 9.15 end the search early on this model (status
-``ROUTING_OPTIMAL`` for a path 9 % above the optimum on 12 waypoints)."""
-
 
 def ortools_time_limit(n: int) -> float:
     """The default time limit for ``n`` waypoints, in seconds.

@@ -1,4 +1,5 @@
-"""Tetromino tiling of a grid workspace (Le et al. 2018): :func:`tile_workspace` with ``method=``.
+"""Tetromino tiling of a grid workspace (Le et al. 2018): :func:`tile_workspace` with ``method=``,
+returning a :class:`TilingResult` (its ``tileset``, and how it was made).
 
 ``"backtracking"`` is the paper's search (with region, colouring and memo pruning), ``"cpsat"`` an
 exact cover by OR-Tools' CP-SAT, ``"auto"`` (the default) a portfolio: the backtracker, a compiled
@@ -19,5 +20,6 @@ from htetro_opt._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
     "tile_workspace": "._tiling", "enumerate_tilings": "._tiling", "find_tiles": "._tiling",
-    "TILING_METHODS": "._tiling", "TilingTimeLimitError": "._tiling", "DEFAULT_TIME_LIMIT": "._tiling",
+    "TILING_METHODS": "._tiling", "TilingTimeLimitError": "._tiling", "DEFAULT_TIME_LIMIT": "._spec",
+    "TilingResult": "._tiling", "SPEC": "._spec",
 })

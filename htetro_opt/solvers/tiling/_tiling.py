@@ -49,9 +49,9 @@ Time limit
 
 Examples
 --------
->>> tile_workspace(np.zeros((2, 4), dtype=bool)).shapes
+>>> tile_workspace(np.zeros((2, 4), dtype=bool)).tileset.shapes
 ('I', 'I')
->>> ts = tile_workspace(np.zeros((2, 4), dtype=bool), shapes="O")
+>>> ts = tile_workspace(np.zeros((2, 4), dtype=bool), shapes="O").tileset
 >>> ts.ids, ts.shapes, ts.complete
 ((1, 2), ('O', 'O'), True)
 """
@@ -60,6 +60,8 @@ from __future__ import annotations
 
 import reprlib
 import time as _time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -79,16 +81,20 @@ from htetro_opt.problems.waypoint_sequencing import (
     check_weights,
 )
 from htetro_opt.scenarios.tileset import Tileset
+from htetro_opt.solvers._result import Result
 from htetro_opt.solvers.tiling._backtracking import _backtracking_tilings
 from htetro_opt.solvers.tiling._common import _shape_text, _TimeLimit
 from htetro_opt.solvers.tiling._cpsat import _cpsat_tilings
 from htetro_opt.solvers.tiling._overlap import _overlapping_tiles
 from htetro_opt.solvers.tiling._portfolio import _auto_tilings
 from htetro_opt.solvers.tiling._prechecks import _precheck
+from htetro_opt._spec import Method
+from htetro_opt.solvers.tiling._spec import DEFAULT_TIME_LIMIT, SPEC
 
 __all__ = [
     "DEFAULT_TIME_LIMIT",
     "TILING_METHODS",
+    "TilingResult",
     "TilingTimeLimitError",
     "enumerate_tilings",
     "find_tiles",
@@ -96,14 +102,43 @@ __all__ = [
 ]
 
 TILING_METHODS = ("auto", "backtracking", "cpsat")
-"""The tiling methods: a portfolio of the others (the default), the paper's backtracking search and
-OR-Tools CP-SAT."""
+"""The tiling algorithms :func:`find_tiles` and :func:`enumerate_tilings` run: a portfolio of the
+others (the default), the paper's backtracking search and OR-Tools CP-SAT (:func:`tile_workspace` takes
+these and any method registered in the spec)."""
 
-DEFAULT_TIME_LIMIT = 60.0
-"""Seconds a tiling may take when ``time_limit`` is None (the library's, the CLI's and the study
-runner's default). Every method is exact, so on a map that passes every pre-check but has no tiling
-the search may have to go through a great many partial tilings before it proves so (a 64 × 64 map
-with T and Z only, say): without a bound such a call could run for hours."""
+# DEFAULT_TIME_LIMIT (60 s, the task spec's) bounds a call whose time_limit is None. Every method is exact, so on
+# a map that passes every pre-check but has no tiling the search may have to go through a great many partial
+# tilings before it proves so (a 64 x 64 map with T and Z only, say): without a bound it could run for hours.
+
+
+@dataclass(frozen=True, eq=False)
+class TilingResult(Result):
+    """A tiling, labelled: the :class:`~htetro_opt.scenarios.Tileset` and how it was made.
+
+    ``tileset`` holds the tiles (numbered 1, 2, … in scan order, each labelled by a robot footprint);
+    ``info`` holds ``shapes`` (tiles per morphology) and ``overlapping`` (the map was covered by two
+    overlapping sub-workspaces). A map that cannot be tiled raises instead (a
+    :class:`~htetro_opt.errors.TilingError` is a proof that no tiling exists), so ``success`` is True.
+    """
+
+    tileset: Tileset
+    method: str
+    runtime_s: float = 0.0
+    info: Mapping = field(default_factory=dict)
+
+    @property
+    def success(self) -> bool:
+        return True
+
+    @property
+    def message(self) -> str:
+        counts = ", ".join(f"{k} {v}" for k, v in self.info["shapes"].items())
+        twice = " (two overlapping sub-workspaces)" if self.tileset.overlapping else ""
+        return f"{len(self.tileset)} tiles: {counts}{twice}"
+
+    def _fields(self) -> dict:
+        return {"tiles": len(self.tileset), "shapes": dict(self.info["shapes"]),
+                "overlapping": bool(self.tileset.overlapping), "complete": bool(self.tileset.complete)}
 
 # ------------------------------------------------------------------------------------------------
 # Validation
@@ -133,12 +168,16 @@ def _check_shapes(shapes) -> tuple[Pattern, ...]:
     return patterns_of(shapes)
 
 
-def _check_options(method, shuffle, seed, time_limit) -> tuple[int | None, float, float]:
+def _check_method(method) -> str:
+    if method not in TILING_METHODS:
+        raise ParameterError(f"unknown tiling method {method!r}: expected one of {', '.join(TILING_METHODS)}")
+    return method
+
+
+def _check_options(shuffle, seed, time_limit) -> tuple[int | None, float, float]:
     """The search's order seed (None: the fixed order), its deadline and its time limit (None:
     :data:`DEFAULT_TIME_LIMIT`), all options checked (the seed too when ``shuffle`` is off and it
     goes unused: a bad value is a mistake either way)."""
-    if method not in TILING_METHODS:
-        raise ParameterError(f"unknown tiling method {method!r}: expected one of {', '.join(TILING_METHODS)}")
     seed = check_seed(seed)
     order_seed = derive_seed(seed) if check_bool(shuffle, "shuffle") else None
     time_limit = check_time_limit(time_limit)
@@ -244,76 +283,103 @@ def find_tiles(occupancy, *, shapes=None, method: str = "auto", shuffle: bool = 
     """
     occ, _ = _as_occupancy(occupancy, "occupancy")
     patterns = _check_shapes(shapes)
-    seed, deadline, time_limit = _check_options(method, shuffle, seed, time_limit)
+    method = _check_method(method)
+    seed, deadline, time_limit = _check_options(shuffle, seed, time_limit)
     try:
         return _tilings(occ, patterns, method, seed, deadline, 1)[0]
     except _TimeLimit as err:
         raise _retime(method, time_limit) from err
 
 
-def tile_workspace(workspace, *, shapes=None, method: str = "auto", shuffle: bool = False, seed=None,
-                   time_limit: float | None = None, overlap: bool = False, weights=DEFAULT_BLOCK_WEIGHTS,
-                   name: str = "") -> Tileset:
+def tile_workspace(workspace, *, method: str = SPEC.default, **options) -> TilingResult:
     """Tile a workspace and label the tiles by Algorithm 1: the waypoints of Le et al. 2018.
 
     Parameters
     ----------
     workspace : Workspace or ndarray of bool, shape (H, W)
         The map (``occ[y, x]`` True for an obstacle).
-    shapes, method, shuffle, seed, time_limit
-        As in :func:`find_tiles`; the time limit covers the whole call, splits included.
-    overlap : bool
-        When the free cells do not tile as they are, split the grid into two overlapping bands of
-        rows (``y < k2`` and ``y >= k1``) or of columns whose free cells both tile, the split with
-        the fewest shared free cells first (ties: rows before columns, then smaller ``k1``), and keep
-        the tiles of both: the shared cells are covered twice (Le et al. 2018, §3.1, Fig. 5d–f). A
-        map that tiles as it is is tiled normally.
-    weights : sequence of 4 float
-        α, β, λ, γ of eq. 2, for Algorithm 1's choice among a symmetric tile's options.
-    name : str
-        The tileset's name.
+    method : str or callable, keyword-only
+        A method of the task's spec (:data:`~htetro_opt.solvers.tiling.SPEC`): ``"auto"`` (default),
+        ``"backtracking"`` or ``"cpsat"``, see :func:`find_tiles`. Or a callable
+        ``method(occupancy, *, shapes, shuffle, seed, time_limit)`` returning the tiles as
+        :func:`find_tiles` does (so is a method registered in the spec); its tiles are checked to cover
+        every free cell once (with ``overlap``, the callable is given the whole map only).
+    **options
+        Checked and defaulted by the spec before any work:
+
+        shapes, shuffle, seed, time_limit
+            As in :func:`find_tiles` (the seed only with ``shuffle``); the time limit covers the whole
+            call, splits included (default :data:`DEFAULT_TIME_LIMIT`, 60 s).
+        overlap : bool
+            When the free cells do not tile as they are, split the grid into two overlapping bands of
+            rows (``y < k2`` and ``y >= k1``) or of columns whose free cells both tile, the split with
+            the fewest shared free cells first (ties: rows before columns, then smaller ``k1``), and
+            keep the tiles of both: the shared cells are covered twice (Le et al. 2018, §3.1,
+            Fig. 5d–f). A map that tiles as it is is tiled normally.
+        weights : sequence of 4 float
+            α, β, λ, γ of eq. 2, for Algorithm 1's choice among a symmetric tile's options.
+        name : str
+            The tileset's name.
 
     Returns
     -------
-    Tileset
-        Tiles numbered 1, 2, … in scan order, each labelled by a robot footprint.
+    TilingResult
+        Its ``tileset``: tiles numbered 1, 2, … in scan order, each labelled by a robot footprint.
 
     Raises
     ------
     TilingError
         As :func:`find_tiles`; with ``overlap``, when no split tiles either.
     UnknownShapeError, ParameterError
-        On invalid options.
+        On invalid options (an unknown one among them, naming the method's options).
 
     Examples
     --------
-    >>> ts = tile_workspace(np.zeros((7, 6), dtype=bool), overlap=True)
-    >>> len(ts), int(ts.coverage().sum()), ts.complete
-    (12, 48, True)
+    >>> result = tile_workspace(np.zeros((7, 6), dtype=bool), overlap=True)
+    >>> ts = result.tileset
+    >>> len(ts), int(ts.coverage().sum()), ts.complete, result.method
+    (12, 48, True, 'auto')
     """
+    began = _time.perf_counter()
     occ, cell_size = _as_occupancy(workspace, "workspace")
-    patterns = _check_shapes(shapes)
-    seed, deadline, time_limit = _check_options(method, shuffle, seed, time_limit)
-    check_weights(weights)
-    overlap = check_bool(overlap, "overlap")
+    if callable(method):
+        chosen = Method(getattr(method, "__name__", type(method).__name__), method, "a user's tiler",
+                        tuple(SPEC.options), seeded=True)
+    else:
+        chosen = SPEC.method(method)
+    options = SPEC.check(chosen, options)
+    patterns = _check_shapes(options["shapes"])
+    seed, deadline, time_limit = _check_options(options["shuffle"], options["seed"], options["time_limit"])
+    weights, name = check_weights(options["weights"]), options["name"]
     if not isinstance(name, str):
         raise ParameterError(f"name must be a string, got {type(name).__name__} {reprlib.repr(name)}")
+    if chosen.function is not None:  # a user's tiler: its tiles checked by Algorithm 1's labelling
+        tiles = chosen.load(SPEC.package)(occ, shapes=options["shapes"], shuffle=options["shuffle"],
+                                          seed=options["seed"], time_limit=time_limit)
+        tileset = block_locations(occ, tiles, weights=weights, cell_size=cell_size, name=name)
+        return _result(tileset, chosen.name, began)
     try:
         try:
-            tiles = _tilings(occ, patterns, method, seed, deadline, 1)[0]
+            tiles = _tilings(occ, patterns, chosen.name, seed, deadline, 1)[0]
         except _TimeLimit:
             raise
         except TilingError as err:
-            if not overlap:
+            if not options["overlap"]:
                 raise
 
             def tile(band):  # each band by the same method, pre-checks included
-                return _tilings(band, patterns, method, seed, deadline, 1)[0]
+                return _tilings(band, patterns, chosen.name, seed, deadline, 1)[0]
 
             tiles = _overlapping_tiles(occ, patterns, deadline, err, tile)
     except _TimeLimit as err:
-        raise _retime(method, time_limit) from err
-    return block_locations(occ, tiles, weights=weights, cell_size=cell_size, name=name)
+        raise _retime(chosen.name, time_limit) from err
+    return _result(block_locations(occ, tiles, weights=weights, cell_size=cell_size, name=name), chosen.name, began)
+
+
+def _result(tileset: Tileset, method: str, began: float) -> TilingResult:
+    counts = {shape: tileset.shapes.count(shape) for shape in sorted(set(tileset.shapes))}
+    return TilingResult(tileset, method, _time.perf_counter() - began,
+                        {"shapes": counts, "overlapping": bool(tileset.overlapping)})
 
 
 def enumerate_tilings(workspace, *, shapes=None, limit: int = 10, method: str = "auto",
@@ -357,7 +423,8 @@ def enumerate_tilings(workspace, *, shapes=None, limit: int = 10, method: str = 
     occ, cell_size = _as_occupancy(workspace, "workspace")
     patterns = _check_shapes(shapes)
     limit = check_int(limit, "limit", minimum=1)
-    _, deadline, time_limit = _check_options(method, False, None, time_limit)
+    method = _check_method(method)
+    _, deadline, time_limit = _check_options(False, None, time_limit)
     check_weights(weights)
     try:
         found = _tilings(occ, patterns, method, None, deadline, limit)

@@ -1,0 +1,130 @@
+"""The coverage task, declared once: :func:`~htetro_opt.solvers.coverage.plan_coverage`'s methods and
+options (Cheng et al. 2019).
+
+:data:`SPEC` is what ``plan_coverage``, the command line's ``cover`` and the study runner's ``cover``
+task read (see :mod:`htetro_opt._spec`). Importing it loads no networkx or scipy.
+"""
+
+from __future__ import annotations
+
+from htetro_opt._spec import Method, Option, Problem, TaskSpec
+from htetro_opt._validation import check_bool, check_int, check_real, check_time_limit
+from htetro_opt.errors import ParameterError, ScenarioError
+
+__all__ = ["SPEC", "DEFAULT_LAYERS", "ENDS", "MOPUP_ORDERS", "STARTS"]
+
+DEFAULT_LAYERS = ("O", "vI", "hI")
+"""The paper's best morphology set (Table 2: {O, vI, hI} with 4-row stripes)."""
+
+ENDS = ("sweep", "both")
+"""Where a stripe's sweep may be left: at its far end (the paper's cut-edges), or at either end."""
+
+MOPUP_ORDERS = ("sequenced", "nearest")
+"""How the cells the sweeps or lanes left are visited: 2-opt/Or-opt over exact leg costs, or nearest first."""
+
+STARTS = ("scenario", "auto")
+"""Where a scenario's plan starts: its roadmap's first pose (and ends at its last), or the bottom-left pose
+of the first layer (a free end)."""
+
+
+def _choice(choices):
+    def check(value, name):
+        if not isinstance(value, str) or value not in choices:
+            raise ParameterError(f"{name} must be one of {', '.join(choices)}, got {value!r}")
+        return value
+    return check
+
+
+def _layers(value, name):
+    """A morphology set: ``"O,vI"`` or ``["O", "vI"]`` (any form of ``parse_layers``), as its layers' names
+    joined by commas."""
+    from htetro_opt.errors import UnknownShapeError
+    from htetro_opt.solvers.coverage._layers import parse_layers
+
+    if not isinstance(value, (str, list, tuple)):
+        raise ParameterError(f"{name} must be morphology layers such as 'O,vI,hI' or ['O', 'hI'], got {value!r}")
+    try:
+        return ",".join(layer.name for layer in parse_layers(value))
+    except UnknownShapeError as err:
+        raise ParameterError(f"{name}: {err.args[0]}") from None
+
+
+def _stripes(value, name):
+    """Stripe widths: a width (an int, or ``"4"``) or widths bottom up (``[2, 3, 2]`` or ``"2,3,2"``), each
+    a positive integer; whether they fit a map is the planner's check, against the map's height."""
+    if isinstance(value, str):  # the command line's "--stripes 2,3,2"
+        parts = [p.strip() for p in value.split(",")]
+        if not all(p.isdigit() for p in parts):
+            raise ParameterError(f"{name} must be a width or comma-separated widths such as '2,3,2', got {value!r}")
+        value = int(parts[0]) if len(parts) == 1 else [int(p) for p in parts]
+    if isinstance(value, (list, tuple)):
+        if not value:
+            raise ParameterError(f"{name} must name at least one width, got {value!r}")
+        return [check_int(v, f"{name}[{i}]", minimum=1) for i, v in enumerate(value)]
+    try:
+        return check_int(value, name, minimum=1)
+    except ParameterError:
+        raise ParameterError(f"{name} must be a width (an integer >= 1) or a list of widths bottom up, "
+                             f"got {value!r}") from None
+
+
+OPTIONS = (
+    Option("shapes", _layers, "morphology layers: O, vI, hI or SHAPE@H, comma-separated", default=",".join(DEFAULT_LAYERS),
+           stage="problem", metavar="LAYERS"),
+    Option("start", _choice(STARTS), "scenario: the roadmap's first pose as start and last as goal (auto when the "
+           "scenario has none); auto: the bottom-left pose of the first layer, a free end", default="scenario",
+           stage="problem", choices=STARTS),
+    Option("clearance", lambda v, n: check_real(v, n, minimum=0.0), "clearance δ in cells around every block",
+           default=0.0, type=float, metavar="δ"),
+    Option("stripes", _stripes, "stripe width W (H // W bands, the last taking the remainder) or widths bottom up, "
+           "e.g. 2,3,2", default=4, metavar="W|W1,W2,..."),
+    Option("region_columns", lambda v, n: check_int(v, n, minimum=1), "columns of a region", default=4, type=int,
+           metavar="N"),
+    Option("budget", lambda v, n: check_int(v, n, minimum=1), "search nodes per region before its greedy walk is "
+           "taken", default=20_000, type=int, metavar="N"),
+    Option("ends", _choice(ENDS), "leave a stripe at its sweep's far end (sweep) or at either end (both: every "
+           "stripe swept either way, or out and back; never costlier)", default="sweep", choices=ENDS),
+    Option("mopup", _choice(MOPUP_ORDERS), "how the cells the sweeps left are visited: re-ordered by 2-opt and "
+           "Or-opt over exact leg costs (sequenced), or nearest first", default="sequenced", choices=MOPUP_ORDERS),
+    Option("memo", check_bool, "memoise region searches by their content (False gives the same plan, slower)",
+           default=True, flag="", study=False),
+    Option("time_limit", check_time_limit, "seconds; past them the remaining regions take their greedy walk",
+           type=float, metavar="S", default_text="none"),
+)
+
+_PAPER = "Cheng et al. 2019"
+_STRIPES = ("clearance", "stripes", "region_columns", "budget", "ends", "mopup", "memo", "time_limit",
+            "shapes", "start")
+
+METHODS = (
+    Method("stripes", "._stripes:plan_stripes", "the paper's stripes, regions and auxiliary DAG, with our "
+           "readings and additions", _STRIPES, origin="ours", paper=_PAPER, family=("stripes",)),
+    Method("stripes-paper", "._stripes:plan_stripes", "its Alg. 5 (simple paths, cuts at forced poses)", _STRIPES,
+           presets={"paper": True}, origin="paper", paper=_PAPER, family=("stripes",)),
+    Method("boustrophedon", "._baselines:boustrophedon_path", "lanes in the first layer (a baseline)",
+           ("clearance", "mopup", "shapes", "start"), origin="baseline", paper=_PAPER),
+    Method("tiling-tsp", "._baselines:tiling_tsp_tokens", "tile with the shapes, order the tiles, drive through "
+           "them (a baseline)", ("clearance", "time_limit", "shapes", "start"), origin="baseline", paper=_PAPER),
+)
+
+
+def _pose(scenario, *, shapes=",".join(DEFAULT_LAYERS), start="scenario") -> Problem:
+    """A grid scenario's map and the morphology layers; with ``start="scenario"`` its roadmap's first and
+    last poses as the plan's start and goal (a free start and end when it has none)."""
+    from htetro_opt.scenarios import Scenario, load_scenario
+
+    loaded = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+    if not isinstance(loaded, Scenario):
+        raise ScenarioError(f"scenario {loaded.name!r} is continuous; coverage needs a grid scenario")
+    ends = {}
+    if start == "scenario" and loaded.roadmap:
+        ends = {"start": loaded.start, "goal": loaded.goal}
+    return Problem(loaded.name, (loaded.workspace, shapes), kwargs=ends, scenario=loaded)
+
+
+SPEC = TaskSpec(
+    "coverage", package="htetro_opt.solvers.coverage", entry="._dispatch:plan_coverage", options=OPTIONS,
+    methods=METHODS, default="stripes", families={"stripes": "the stripes methods"}, pose=_pose,
+)
+"""The coverage task (see the module docstring). It has no exact method: a study measures a plan
+against its lower bound on the action cost instead."""

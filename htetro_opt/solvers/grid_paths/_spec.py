@@ -1,0 +1,219 @@
+"""The grid-path task, declared once: :func:`~htetro_opt.solvers.grid_paths.plan_path`'s methods and options.
+
+:data:`SPEC` is what ``plan_path``, the command line's ``plan`` (on grid scenarios) and the study runner's
+``plan`` task read (see :mod:`htetro_opt._spec`). Importing it loads no pymoo, numba or scikit-fem.
+"""
+
+from __future__ import annotations
+
+from htetro_opt._spec import Method, Option, Problem, TaskSpec, seed_option
+from htetro_opt._validation import check_bool, check_int, check_real
+from htetro_opt.algorithms import CONVERGENCE_MEASURES, PICKS
+from htetro_opt.errors import ParameterError, PlanningError, ScenarioError
+
+__all__ = ["SPEC", "HEAT_ELEMENTS", "HEAT_ENGINES", "BAND_SEEDS", "GA_PATIENCE"]
+
+HEAT_ELEMENTS = ("q1", "p0")
+"""Elements :func:`~htetro_opt.solvers.grid_paths.solve_heat_field` knows: the bilinear quadrilateral
+(the paper's) and DG0 (ours)."""
+
+HEAT_ENGINES = ("dijkstra", "wavefront")
+"""The heat planner's searches of a leg: scipy's Dijkstra, or the paper's waves relaxed to convergence
+(same optimum)."""
+
+BAND_SEEDS = ("ascent", "grid_distance")
+"""Lines the heat planner's band follows: the field's steepest-ascent line, or a shortest cell path
+(an ablation)."""
+
+GA_PATIENCE = {"best": 100, "hypervolume": 20}
+"""The GAs' patience by convergence measure, when ``patience`` is not given (measured: see plan_ga)."""
+
+
+def _int(minimum: int, *, none: bool = False):
+    return lambda value, name: check_int(value, name, minimum=minimum, allow_none=none)
+
+
+def _real(minimum: float = 0.0, *, above: bool = False, none: bool = False):
+    return lambda value, name: check_real(value, name, minimum=minimum, include_minimum=not above, allow_none=none)
+
+
+def _choice(choices):
+    def check(value, name):
+        if not isinstance(value, str) or value not in choices:
+            raise ParameterError(f"{name} must be one of {', '.join(choices)}, got {value!r}")
+        return value
+    return check
+
+
+def _anything(value, name):  # checked where it is used (the simulator checks its commands and timing)
+    return value
+
+
+def _callback(value, name):
+    from htetro_opt._progress import check_progress
+
+    return check_progress(value, name)
+
+
+def _heat_weights(value, name):
+    from htetro_opt.problems.heat_costs import check_heat_weights
+
+    return check_heat_weights(value, name)
+
+
+def _band(value, name):
+    if value in ("auto", "full"):
+        return value
+    if isinstance(value, str) and value.strip().isdigit():  # the command line's "--band 8"
+        value = int(value)
+    try:
+        return check_int(value, name, minimum=1)
+    except ParameterError:
+        raise ParameterError(f"{name} must be auto, full or a radius in cells (an integer >= 1), got {value!r}") from None
+
+
+OPTIONS = (
+    Option("clearance", _real(), "clearance δ in cells around every block", default=0.0, type=float, metavar="δ",
+           reference=True),
+    Option("diagonals", check_bool, "allow diagonal translations", default=False, type=bool, reference=True),
+    Option("commands", _anything, "the command tokens the simulator compiles (default: the method's set)",
+           flag="", study=False),
+    Option("timing", _anything, "a Timing of the commands' durations", flag="", study=False),
+    Option("t0", _int(0), "commands executed before the plan starts (the clock of moving obstacles)", default=0,
+           flag="", study=False),
+    # the GAs over command chromosomes (Cheng et al. 2020; pymoo's algorithms on the same problem)
+    Option("pop_size", _int(2), "population size n_pop", default=50, type=int, metavar="N"),
+    Option("max_gen", _int(1), "generations per roadmap leg at most", default=1000, type=int, metavar="N"),
+    Option("patience", _int(1, none=True), "stop a leg after this many generations without improvement once "
+           "its goal is reached", type=int, metavar="N",
+           default_text=", ".join(f"{n} with --converge {m}" for m, n in GA_PATIENCE.items())),
+    Option("convergence", _choice(CONVERGENCE_MEASURES), "what counts as an improvement for --patience: best, a "
+           "rise of the goal-reaching members' best f_t, f_sm, f_sf or fitness sum; hypervolume, of the best f_t "
+           "or of their front's hypervolume (half the generations, a slightly smaller front)", default="best",
+           flag="--converge", choices=CONVERGENCE_MEASURES),
+    Option("max_length", _int(1, none=True), "l_p,max, the initial chromosome length", type=int, metavar="L",
+           default_text="per leg, the least multiple of 100 whose time is at least 1.5 times the leg's exact "
+           "minimum time, as the paper's 100 and 200 on its maps"),
+    seed_option(),
+    Option("replan_window", _int(0), "windowed exact re-planning (ours): each generation a window of up to W "
+           "executed commands of the fastest and of --replan-members random goal-reaching members is replaced by "
+           "the minimum-time path between its ends; 0 off", type=int, metavar="W"),
+    Option("replan_members", _int(0), "random goal-reaching members re-planned each generation besides the "
+           "fastest", default=3, type=int, metavar="K"),
+    Option("reach_share", _real(0.0, above=True), "cap on the goal-reaching section of the hTetro-GA's sort, a "
+           "share in (0, 1] of n_pop (ours; 1: the paper's sort)", default=1.0, type=float, metavar="S"),
+    Option("reach_patience", _int(0), "reach repair (ours): when no member has reached the goal and the best "
+           "goal reachability has not risen for N generations, the member nearest to the goal gets the "
+           "minimum-time path to it; 0 off", type=int, metavar="N"),
+    Option("polish_window", _int(0), "balanced polish (ours): when each leg's run ends, the largest-sum "
+           "leading-front member has windows of up to W commands re-planned exactly for the largest fitness sum; "
+           "0 off", type=int, metavar="W"),
+    Option("conservative", check_bool, "add the hTetro-GA's conservative offspring set (removal, rearrangement, "
+           "shortcut of every member) to the algorithm's mating, so that a swap compares algorithms, not operator "
+           "sets", default=False, type=bool),
+    Option("seed_exact", check_bool, "put each leg's exact minimum-time plan into its initial population; the "
+           "JSON then reports the gaps to the exact optimum", default=False, type=bool),
+    Option("pick", _choice(tuple(PICKS)), "the solution each leg returns: balanced, the largest sum of the four "
+           "fitnesses (the paper's multi-objective solution), or the best f_t, f_sm or f_sf", default="balanced",
+           choices=tuple(PICKS)),
+    Option("sampling_weights", _anything, "λ_mc of Algorithm 1 (token → weight)", flag="", study=False),
+    Option("verbose", check_bool, "print pymoo's per-generation log", default=False, flag="", study=False),
+    Option("hv_reference", _anything, "record each leg's hypervolume by generation against this point",
+           flag="", study=False),
+    Option("progress", _callback, "progress(done, total, note) after every generation", flag="", study=False),
+    # Do et al. 2021's heat-conduction planner
+    Option("weights", _heat_weights, "weights of time, smoothness and safety (eq. 12)", default=(1.0, 0.0, 0.0),
+           metavar="WT,WSM,WSF"),
+    Option("t_max", _real(0.0, above=True, none=True), "t_max of f_t in seconds", type=float, metavar="S",
+           default_text="half an O-shape boustrophedon of the empty map"),
+    Option("element", _choice(HEAT_ELEMENTS), "the field's element, bilinear q1 (the paper's) or cell-centred p0",
+           default="q1", choices=HEAT_ELEMENTS),
+    Option("monotone", check_bool, "drop the rule that translations never go down the temperature field",
+           default=True, type=bool, flag="", off_flag="--no-monotone"),
+    Option("band", _band, "search the whole pose graph (full), or a band of R cells around the field's ascent "
+           "line, widened until a path is found (auto: full up to 4 million poses, else R 8)", default="auto",
+           metavar="auto|full|R"),
+    Option("band_seed", _choice(BAND_SEEDS), "where the band is centred: the field's ascent line or a "
+           "grid-distance path", default="ascent", flag="", choices=BAND_SEEDS),
+    Option("engine", _choice(HEAT_ENGINES), "the pose-graph search", default="dijkstra", flag="", choices=HEAT_ENGINES),
+    Option("field_options", _anything, "options of solve_heat_field", flag="", study=False),
+    Option("keep_fields", check_bool, "keep the legs' temperature fields in the plan's info (for plots)",
+           default=False, flag="", study=False),
+    Option("sensor_range", _real(0.0, above=True, none=True), "run in the true world (hidden obstacles), sensing "
+           "cells within R cells of the blocks and replanning when the plan meets a new obstacle (Do et al. "
+           "2021: 6)", type=float, metavar="R", stage="problem", default_text="off: plan on the known map"),
+)
+
+_SIMULATOR = ("clearance", "commands", "timing")
+_GA = (*_SIMULATOR, "pop_size", "max_gen", "patience", "convergence", "max_length", "seed", "replan_window",
+       "replan_members", "seed_exact", "pick", "sampling_weights", "verbose", "hv_reference", "progress")
+_HTETRO_GA = (*_GA, "reach_share", "reach_patience", "polish_window")
+_PYMOO = (*_GA, "conservative")
+_GA_KIND = dict(seeded=True, family=("ga",), capabilities={"progress"}, problem={"diagonals": False},
+                paper="Cheng et al. 2020")
+_OURS = {"replan_window": 40, "reach_patience": 100, "polish_window": 40}
+_OFF = {"replan_window": 0, "reach_patience": 0, "polish_window": 0}
+
+
+def _exact(name: str, summary: str) -> Method:
+    return Method(name, "._exact:plan_exact", summary, (*_SIMULATOR, "diagonals", "t0"), presets={"method": name},
+                  exact=True, origin="reference", family=("exact",))
+
+
+def _pymoo(name: str, label: str) -> Method:
+    return Method(name, "._ga:plan_ga", f"pymoo's {label} on the hTetro-GA's problem and operators", _PYMOO,
+                  defaults={"replan_window": 0}, presets={"algorithm": name}, origin="library",
+                  **{**_GA_KIND, "family": ("ga", "pymoo")})
+
+
+METHODS = (
+    _exact("dijkstra", "the minimum-time plan over (x, y, shape, heading), time-expanded for moving obstacles"),
+    _exact("astar", "the same optimum by A*"),
+    Method("htetro-ga", "._ga:plan_ga", "Cheng et al. 2020's multi-objective GA over command chromosomes, with our "
+           "additions", _HTETRO_GA, defaults=_OURS, presets={"algorithm": "htetro-ga"}, origin="ours",
+           **{**_GA_KIND, "family": ("ga", "htetro-ga")}),
+    Method("htetro-ga-paper", "._ga:plan_ga", "the same GA as published", _HTETRO_GA, defaults=_OFF,
+           presets={"algorithm": "htetro-ga-paper"}, origin="paper", **{**_GA_KIND, "family": ("ga", "htetro-ga")}),
+    _pymoo("nsga2", "NSGA-II"),
+    _pymoo("nsga3", "NSGA-III"),
+    _pymoo("smsemoa", "SMS-EMOA"),
+    _pymoo("agemoea", "AGE-MOEA"),
+    Method("heat", "._heat:plan_heat", "Do et al. 2021's search up a heat-conduction field (diagonals included, "
+           "static maps)", (*_SIMULATOR, "weights", "t_max", "element", "monotone", "band", "band_seed", "engine",
+                            "field_options", "keep_fields", "sensor_range"),
+           origin="ours", paper="Do et al. 2021", family=("heat",), problem={"diagonals": True}),
+)
+
+
+def _pose(scenario, *, sensor_range=None) -> Problem:
+    """A grid scenario's map and roadmap (a bundled name, a file or a loaded Scenario)."""
+    from htetro_opt.scenarios import Scenario, load_scenario
+
+    loaded = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+    if not isinstance(loaded, Scenario):
+        raise ScenarioError(f"scenario {loaded.name!r} is continuous; this task needs a grid scenario")
+    if loaded.goal is None:
+        raise PlanningError(f"scenario {loaded.name!r} has no roadmap with a start and a goal to plan for")
+    return Problem(loaded.name, (loaded.workspace, loaded.roadmap), scenario=loaded,
+                   extras={"sensor_range": sensor_range})
+
+
+def _solve(spec: TaskSpec, problem: Problem, method, options: dict):
+    """``plan_path``, or with a sensor range the heat planner's run in the true world (as a plan)."""
+    sensor_range = problem.extras.get("sensor_range")
+    if sensor_range is None:
+        return spec.entry_point()(*problem.args, method=method, **options)
+    from htetro_opt.solvers.grid_paths._replan import replan_heat
+
+    options = spec.check(method, options)
+    return replan_heat(problem.scenario, sensor_range=sensor_range, **options).as_plan()
+
+
+SPEC = TaskSpec(
+    "grid-path planning", package="htetro_opt.solvers.grid_paths", entry="._dispatch:plan_path", options=OPTIONS,
+    methods=METHODS, default="dijkstra", exact="dijkstra", aliases={"exact": "dijkstra"},
+    families={"exact": "the exact methods", "ga": "the GA methods", "htetro-ga": "the hTetro-GA methods",
+              "pymoo": "pymoo's algorithms", "heat": "the heat planner"},
+    pose=_pose, solve=_solve,
+)
+"""The grid-path task (see the module docstring)."""

@@ -1,0 +1,273 @@
+"""The sequencing task, declared once: :func:`~htetro_opt.solvers.sequencing.sequence_waypoints`'s methods
+and options (Le et al. 2018's waypoint TSP, and TSPLIB instances).
+
+:data:`SPEC` is what ``sequence_waypoints``, the command line's ``sequence`` and the study runner's
+``sequence`` task read (see :mod:`htetro_opt._spec`). A method is a function
+``solve_<name>(instance, *, <its options>) -> (order, info)``; the entry point resolves ``auto``, hands a
+closed tour or a fixed end to a method without the ``tours`` capability as an open path, and re-prices
+every answer. Importing the spec loads no scipy, numba, OR-Tools or DEAP.
+"""
+
+from __future__ import annotations
+
+from htetro_opt._spec import Method, Option, Problem, TaskSpec, seed_option
+from htetro_opt._validation import check_bool, check_int, check_probability, check_real, check_time_limit
+from htetro_opt.errors import ParameterError
+
+__all__ = ["SPEC", "EXACT_AUTO_LIMIT", "EXACT_MAX_SIZE", "EXACT_TIME_LIMIT", "FAST_TSP_CANDIDATES",
+           "FIRST_SOLUTIONS", "ILS_NEIGHBOURS"]
+
+EXACT_AUTO_LIMIT = 40
+"""``auto`` proves the optimum with the exact solver up to this many waypoints (a closed tour counts
+one more, the copy of its first waypoint); beyond, see :func:`~htetro_opt.solvers.sequencing.auto_method`."""
+
+EXACT_MAX_SIZE = 40
+"""Default largest instance :func:`~htetro_opt.solvers.sequencing.solve_exact` accepts (its ``max_size``)."""
+
+EXACT_TIME_LIMIT = 60.0
+"""Default wall-clock budget of :func:`~htetro_opt.solvers.sequencing.solve_exact`, in seconds."""
+
+ILS_NEIGHBOURS = 8
+"""Size of each node's neighbour (candidate) list in ``ils``."""
+
+FIRST_SOLUTIONS = (
+    "AUTOMATIC", "PATH_CHEAPEST_ARC", "PATH_MOST_CONSTRAINED_ARC", "SAVINGS", "PARALLEL_SAVINGS",
+    "PARALLEL_CHEAPEST_INSERTION", "SEQUENTIAL_CHEAPEST_INSERTION", "LOCAL_CHEAPEST_INSERTION",
+    "LOCAL_CHEAPEST_COST_INSERTION", "GLOBAL_CHEAPEST_ARC", "LOCAL_CHEAPEST_ARC", "FIRST_UNBOUND_MIN_VALUE",
+)
+"""OR-Tools' first-solution strategies accepted as ``first_solution``. Left out: ``SWEEP`` (needs
+waypoint coordinates, the model is invalid without them), and ``CHRISTOFIDES`` and
+``BEST_INSERTION``, which with OR-Tools 9.15 end the search early on this model (status
+``ROUTING_OPTIMAL`` for a path 9 % above the optimum on 12 waypoints)."""
+
+FAST_TSP_CANDIDATES = ("auto", "nearest", "alpha")
+"""fast-tsp's neighbour lists (its ``candidates``): see :func:`~htetro_opt.solvers.sequencing.solve_fast_tsp`."""
+
+
+def _int(minimum: int, *, none: bool = False):
+    return lambda value, name: check_int(value, name, minimum=minimum, allow_none=none)
+
+
+def _choice(choices):
+    def check(value, name):
+        if not isinstance(value, str) or value not in choices:
+            raise ParameterError(f"{name} must be one of {', '.join(choices)}, got {value!r}")
+        return value
+    return check
+
+
+def _callback(value, name):
+    from htetro_opt._progress import check_progress
+
+    return check_progress(value, name)
+
+
+def _label(value, name):
+    """A tile or node label (a positive integer, or its text), or ``"free"``."""
+    if value in (None, "free"):
+        return value
+    if isinstance(value, str) and value.strip().isdigit():  # the command line's "--start 1"
+        value = int(value)
+    try:
+        return check_int(value, name, minimum=1)
+    except ParameterError:
+        raise ParameterError(f"{name} must be a tile label (a positive integer) or 'free', got {value!r}") from None
+
+
+def _end(value, name):
+    if value == "free":
+        raise ParameterError(f"{name} must be a tile label (a positive integer): an open path's end is free "
+                             "unless given")
+    return _label(value, name)
+
+
+def _weights(value, name):
+    from htetro_opt.problems.waypoint_sequencing import check_weights  # light: numpy only
+
+    if isinstance(value, str):  # the command line's "0.4,0.2,0.2,0.2"
+        try:
+            value = [float(v) for v in value.split(",")]
+        except ValueError:
+            raise ParameterError(f"{name} must be four comma-separated numbers a,b,c,d, got {value!r}") from None
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 4:
+        raise ParameterError(f"{name} must be four numbers a,b,c,d, got {value!r}")
+    values = [check_real(v, f"{name}[{i}]", minimum=0.0, maximum=1e6) for i, v in enumerate(value)]
+    try:
+        return tuple(float(v) for v in check_weights(values))
+    except ParameterError as err:
+        raise ParameterError(f"{name}: {err}") from None
+
+
+def _shapes(value, name):
+    from htetro_opt.model.robot import SHAPES
+
+    if value is None:
+        return None
+    if isinstance(value, (list, tuple)) and all(isinstance(v, str) for v in value):
+        value = "".join(value)
+    if not isinstance(value, str) or not value or any(letter not in SHAPES for letter in value):
+        raise ParameterError(f"{name} must be morphology letters of {''.join(SHAPES)} such as 'TZ', got {value!r}")
+    return value
+
+
+OPTIONS = (
+    # how a tileset, a scenario or a TSPLIB file is posed as an instance
+    Option("start", _label, "label of the start tile or TSPLIB node, or 'free'", default=1, stage="problem",
+           reference=True),
+    Option("end", _end, "open paths: label of the tile or TSPLIB node the order ends at", stage="problem",
+           reference=True, default_text="free"),
+    Option("closed", check_bool, "a closed tour, back to the start (--open: an open path)", type=bool,
+           flag="--closed", off_flag="--open", stage="problem", reference=True,
+           default_text="closed for TSPLIB files, open for tilesets"),
+    Option("weights", _weights, "tilesets: eq. 2's weights α,β,λ,γ of blocks a,b,c,d", default=(0.25,) * 4,
+           metavar="A,B,C,D", stage="problem", reference=True),
+    Option("shapes", _shapes, "when TILESET is a scenario: allowed morphologies for its tiling (by tile's "
+           "default method)", stage="problem", reference=True, default_text="all seven"),
+    # the methods' own
+    seed_option(),
+    Option("time_limit", check_time_limit, "time budget in seconds", type=float, metavar="S",
+           default_text="sized to the instance (see sequencing's default_time_limit)"),
+    Option("progress", _callback, "progress(done, total, note) from the methods that report", flag="",
+           study=False),
+    Option("restarts", _int(0), "kicks of the iterated local search", default=0, type=int, metavar="N"),
+    Option("max_starts", _int(1), "nearest-neighbour starts tried", default=32, flag=""),
+    Option("kicks", _int(0, none=True), "kicks of the iterated local search (0: local search only)", flag="",
+           default_text="sized to the instance (ils_kicks)"),
+    Option("neighbours", _int(1), "size of each node's candidate list", default=ILS_NEIGHBOURS, flag=""),
+    Option("pop_size", _int(2), "population size", default=60, flag=""),
+    Option("max_gen", _int(0), "generations at most", default=2000, flag=""),
+    Option("patience", _int(1, none=True), "generations without improvement before stopping", default=200,
+           flag=""),
+    Option("crossover_rate", lambda v, n: check_probability(v, n), "ordered-crossover rate", default=0.8, flag=""),
+    Option("mutation_rate", lambda v, n: check_probability(v, n), "swap-mutation rate", default=0.2, flag=""),
+    Option("tournament_size", _int(1), "tournament size", default=3, flag=""),
+    Option("elite", _int(0, none=True), "individuals kept unchanged each generation", flag="",
+           default_text="a tenth of the population"),
+    Option("local_search_rate", lambda v, n: check_probability(v, n), "share of offspring improved by 2-opt/Or-opt",
+           default=0.25, flag=""),
+    Option("iterations", _int(1), "random restarts of the greedy search", default=10_000, flag=""),
+    Option("scale", lambda v, n: check_real(v, n, minimum=0.0, include_minimum=False, allow_none=True),
+           "multiplier turning costs into OR-Tools' integers", flag="", default_text="from the largest cost"),
+    Option("first_solution", _choice(FIRST_SOLUTIONS), "OR-Tools' first-solution strategy",
+           default="PATH_CHEAPEST_ARC", flag="", choices=FIRST_SOLUTIONS),
+    Option("max_size", _int(1), "largest instance the exact solver accepts", default=EXACT_MAX_SIZE, flag=""),
+    Option("threads", _int(1), "fast-tsp's threads", default=1, flag=""),
+    Option("candidates", _choice(FAST_TSP_CANDIDATES), "fast-tsp's neighbour lists", default="auto", flag="",
+           choices=FAST_TSP_CANDIDATES),
+    Option("runs", _int(1), "LKH's independent runs, the best kept", default=1, type=int, metavar="N"),
+)
+
+_PAPER = "Le et al. 2018"
+_GA = ("seed", "time_limit", "progress", "pop_size", "max_gen", "patience", "crossover_rate", "mutation_rate",
+       "tournament_size", "elite")
+_PATTERN = dict(capabilities={"asymmetric", "geometry"}, origin="baseline", paper=_PAPER, family=("pattern",))
+
+METHODS = (
+    Method("auto", None, f"exact up to {EXACT_AUTO_LIMIT} waypoints, ils beyond (ortools for asymmetric costs)",
+           ("seed", "time_limit", "progress"), seeded=True, capabilities={"asymmetric", "tours", "implicit"}),
+    Method("exact", "._exact:solve_exact", f"the CP-SAT optimum with a proof (<= {EXACT_MAX_SIZE} waypoints)",
+           ("time_limit", "max_size"), exact=True, origin="reference", capabilities={"asymmetric"}),
+    Method("ortools", "._ortools:solve_ortools", "OR-Tools routing with guided local search (the paper's baseline)",
+           ("time_limit", "progress", "scale", "first_solution"), origin="baseline", paper=_PAPER,
+           capabilities={"asymmetric", "progress"}),
+    Method("ils", "._ils:solve_ils", "the compiled, seeded iterated local search (2-opt, Or-opt, double-bridge "
+           "kicks)", ("seed", "time_limit", "kicks", "neighbours"), seeded=True, capabilities={"tours", "implicit"}),
+    Method("local", "._local:solve_local", "nearest neighbour + 2-opt/Or-opt, iterated with --restarts",
+           ("seed", "time_limit", "progress", "restarts", "max_starts"),
+           seeded=lambda options: options.get("restarts", 0) > 0, capabilities={"progress"}),
+    Method("ga", "._ga:solve_ga", "the paper's GA on DEAP with a 2-opt/Or-opt step (memetic, ours)",
+           (*_GA, "local_search_rate"), defaults={"patience": 50}, presets={"memetic": True}, seeded=True,
+           paper=_PAPER, family=("ga",), capabilities={"progress"}),
+    Method("ga-plain", "._ga:solve_ga", "the paper's GA on DEAP", _GA, presets={"memetic": False}, seeded=True,
+           origin="paper", paper=_PAPER, family=("ga",), capabilities={"progress"}),
+    Method("zigzag", "._baselines:solve_zigzag", "the paper's zigzag, one row", presets={"rows": 1}, **_PATTERN),
+    Method("zigzag2", "._baselines:solve_zigzag", "the paper's zigzag, two rows", presets={"rows": 2}, **_PATTERN),
+    Method("spiral", "._baselines:solve_spiral", "the paper's spiral, one row", presets={"rows": 1}, **_PATTERN),
+    Method("spiral2", "._baselines:solve_spiral", "the paper's spiral, two rows", presets={"rows": 2}, **_PATTERN),
+    Method("greedy", "._baselines:solve_greedy", "the paper's greedy search", ("seed", "time_limit", "progress",
+           "iterations"), seeded=True, origin="baseline", paper=_PAPER, capabilities={"asymmetric", "progress"}),
+    Method("fast-tsp", "._backends:solve_fast_tsp", "the fast-tsp package (optional, MIT; time-based, unseeded)",
+           ("time_limit", "threads", "candidates"), origin="external", requires="fast-tsp", capabilities={"tours"}),
+    Method("lkh", "._backends:solve_lkh", "LKH-3 through the elkai package (optional; non-commercial use only)",
+           ("runs",), origin="external", requires="lkh", capabilities={"asymmetric", "tours"}),
+)
+
+
+def _pose(source, *, start=1, end=None, closed=None, weights=(0.25,) * 4, shapes=None) -> Problem:
+    """A labelled tileset, a grid scenario (tiled first, by ``tile``'s default method) or a TSPLIB file as a
+    :class:`~htetro_opt.problems.SequencingInstance`: tilesets open paths, TSPLIB files closed tours."""
+    from dataclasses import replace
+
+    from htetro_opt.problems import SequencingInstance
+
+    kind, loaded = _source(source)
+    if kind == "tsplib":
+        for name, given in (("weights", tuple(weights) != (0.25,) * 4), ("shapes", shapes is not None)):
+            if given:
+                raise ParameterError(f"{name} does not apply to a TSPLIB file (it has no tiles)")
+        closed = True if closed is None else closed
+        if closed and end is not None:
+            raise ParameterError("end applies to open paths (a TSPLIB file is a closed tour unless asked open)")
+        nodes = range(1, loaded.dimension + 1)
+        instance = SequencingInstance.from_matrix(loaded.cost, closed=closed, start=_index(start, nodes, "start", "node"),
+                                                  end=_index(end, nodes, "end", "node"))
+        return Problem(loaded.name, (instance,), scenario=loaded, extras={"instance": instance, "tsplib": loaded})
+    if kind == "tileset":
+        if shapes is not None:
+            raise ParameterError("shapes applies only to a scenario to tile, not to a labelled tileset")
+        tileset = loaded
+    else:
+        from htetro_opt.solvers.tiling import tile_workspace
+
+        tileset = tile_workspace(loaded.workspace, shapes=shapes, name=loaded.name).tileset
+    if start != "free":
+        _index(start, tileset.ids, "start", "tile")  # from_tileset takes the label itself
+    instance = SequencingInstance.from_tileset(tileset, start=None if start == "free" else start, weights=weights)
+    if closed or end is not None:
+        instance = replace(instance, closed=bool(closed), end=_index(end, instance.ids, "end", "tile"))
+    return Problem(tileset.name, (instance,), scenario=loaded, extras={"instance": instance, "tileset": tileset})
+
+
+def _index(label, ids, name: str, what: str):
+    """The index of tile (node) ``label`` among ``ids``; None for None or "free"."""
+    if label is None or label == "free":
+        return None
+    ids = list(ids)
+    if label not in ids:
+        raise ParameterError(f"{name} {label}: there is no {what} {label}")
+    return ids.index(label)
+
+
+def _source(source):
+    """(kind, loaded): a TSPLIB file (.tsp, .atsp), a labelled tileset (a bundled name or any other file) or a
+    grid scenario (a bundled scenario name, a .toml file or a loaded Scenario)."""
+    from htetro_opt.scenarios import Scenario, Tileset, list_scenarios, list_tilesets, load_scenario, load_tileset
+    from htetro_opt.scenarios import scenario_path, tileset_path
+
+    if isinstance(source, Tileset):
+        return "tileset", source
+    if isinstance(source, Scenario):
+        return "scenario", source
+    if not isinstance(source, str):
+        raise ParameterError(f"a sequencing source must be a tileset, a scenario or a file name, got {source!r}")
+    if source.lower().endswith((".tsp", ".atsp")):
+        from htetro_opt.scenarios.tsplib import load_tsplib
+
+        return "tsplib", load_tsplib(source)
+    if source.endswith(".toml") or (source not in list_tilesets() and source in list_scenarios()):
+        scenario_path(source)  # a clear error for a missing file
+        from htetro_opt.errors import ScenarioError
+
+        loaded = load_scenario(source)
+        if not isinstance(loaded, Scenario):
+            raise ScenarioError(f"scenario {loaded.name!r} is continuous; sequencing tiles a grid scenario")
+        return "scenario", loaded
+    return "tileset", load_tileset(tileset_path(source))
+
+
+SPEC = TaskSpec(
+    "sequencing", package="htetro_opt.solvers.sequencing", entry="._dispatch:sequence_waypoints", options=OPTIONS,
+    methods=METHODS, default="auto", exact="exact",
+    families={"ga": "the GA methods", "pattern": "the pattern baselines"}, pose=_pose,
+)
+"""The sequencing task (see the module docstring)."""
