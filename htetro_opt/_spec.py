@@ -30,7 +30,7 @@ import hashlib
 import json
 import numbers
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from importlib import import_module
 from typing import Any
 
@@ -272,9 +272,13 @@ class TaskSpec:
         Other names of methods (``exact`` for the grid's dijkstra).
     families : mapping, optional
         Family name → how messages name it ("the GA methods").
+    common : sequence of str, optional
+        Options every method takes (a sequence's start tile, a plan's clearance): added to each method's
+        own at registration, a method registered later included.
     pose : callable, optional
-        ``pose(scenario, **problem_options) -> Problem``: a scenario (a loaded one, a bundled name or a
-        file) as the entry point's data; see :meth:`pose`.
+        ``pose(scenario, *, label, **problem_options) -> Problem``: a scenario (a loaded one, a bundled
+        name or a file) as the entry point's data, ``label(option)`` naming an option in its messages; see
+        :meth:`pose`.
     solve : callable, optional
         ``solve(spec, problem, method, options) -> result``: how a posed problem is solved (default:
         the entry point called with the problem's data, ``method=`` and the options).
@@ -282,8 +286,8 @@ class TaskSpec:
 
     def __init__(self, name: str, *, package: str, entry: str, options: Sequence[Option], methods: Sequence[Method],
                  default: str, exact: str | None = None, aliases: Mapping[str, str] | None = None,
-                 families: Mapping[str, str] | None = None, pose: Callable | None = None,
-                 solve: Callable | None = None) -> None:
+                 families: Mapping[str, str] | None = None, common: Sequence[str] = (),
+                 pose: Callable | None = None, solve: Callable | None = None) -> None:
         self.name = name
         self.package = package
         self.entry = entry
@@ -292,6 +296,7 @@ class TaskSpec:
             if option.name in self.options:
                 raise ValueError(f"task {name!r}: option {option.name!r} declared twice")
             self.options[option.name] = option
+        self.common = tuple(common)
         self.methods: dict[str, Method] = {}
         for method in methods:
             self.register(method)
@@ -313,13 +318,15 @@ class TaskSpec:
 
     # --- methods ------------------------------------------------------------------------------------
     def register(self, method: Method) -> Method:
-        """Add a method (or replace one of the same name); every reader of the spec then offers it.
+        """Add a method (or replace one of the same name), with the task's :attr:`common` options; every
+        reader of the spec then offers it.
 
         Raises
         ------
         ValueError
             If it takes an option the task does not declare.
         """
+        method = replace(method, options=(*self.common, *(o for o in method.options if o not in self.common)))
         unknown = [o for o in method.options if o not in self.options]
         if unknown:
             raise ValueError(f"method {method.name!r} of task {self.name!r} takes undeclared options {unknown}")
@@ -439,15 +446,17 @@ class TaskSpec:
         module, _, attribute = self.entry.partition(":")
         return getattr(import_module(module, self.package), attribute)
 
-    def pose(self, scenario, **problem_options):
+    def pose(self, scenario, *, naming: str = "keyword", **problem_options):
         """A scenario (loaded, a bundled name or a file) as the entry point's data: a
         :class:`Problem` (the entry point's data, the loaded scenario, and what the records and plots
-        need)."""
+        need). Its errors name the options as ``naming`` says (:meth:`label`)."""
         if self._pose is None:
             raise ParameterError(f"task {self.name!r} takes no scenario")
-        return self._pose(scenario, **problem_options)
+        filled = {name: option.default for name, option in self.options.items() if option.stage == "problem"}
+        filled.update(problem_options)
+        return self._pose(scenario, label=lambda option: self.label(option, naming), **filled)
 
-    def solve(self, scenario, *, method: str | None = None, **options):
+    def solve(self, scenario, *, method: str | None = None, naming: str = "keyword", **options):
         """Pose ``scenario`` with the problem options and solve it with ``method`` and the others.
 
         What a study trial and a command of the command line do: ``spec.solve(scenario, method=…,
@@ -457,11 +466,16 @@ class TaskSpec:
         m = self.method(name) if isinstance(name, str) else None
         problem_options, method_options = self.split(m, options) if m is not None else ({}, dict(options))
         if m is not None:
-            problem_options = self.check(m, problem_options, stage="problem", fill=False)
-        problem = self.pose(scenario, **problem_options)
+            problem_options = self.check(m, problem_options, naming=naming, stage="problem", fill=False)
+        problem = self.pose(scenario, naming=naming, **problem_options)
+        return problem, self.run(problem, method=name, **method_options)
+
+    def run(self, problem: Problem, *, method, **options):
+        """Solve a posed problem (:meth:`pose`) with ``method`` and its options: the entry point, called with
+        the problem's data (or the task's own ``solve``)."""
         if self._solve is not None:
-            return problem, self._solve(self, problem, name, method_options)
-        return problem, self.entry_point()(*problem.args, method=name, **problem.kwargs, **method_options)
+            return self._solve(self, problem, method, options)
+        return self.entry_point()(*problem.args, method=method, **problem.kwargs, **options)
 
     def fingerprint(self, method: str | Method, options: Mapping[str, Any]) -> str:
         """A hash of the code and settings a run of ``method`` stands for: the package version, the

@@ -20,6 +20,8 @@ __all__ = [
     "TilingError",
     "TilingTimeLimitError",
     "OutputError",
+    "StudyError",
+    "WorkerLost",
 ]
 
 
@@ -90,3 +92,13 @@ class ParameterError(HtetroError, ValueError):
 class OutputError(HtetroError, OSError):
     """An output file (a tileset, plot, study table) cannot be written: a missing folder, a folder in
     the way, no permission, a full disk."""
+
+
+class StudyError(ParameterError):
+    """A study (a TOML file or a :class:`~htetro_opt.studies.Study` built in Python) is invalid: the
+    message names the file, the method entry (``methods[i]``, counted from 0) and the key."""
+
+
+class WorkerLost(HtetroError, RuntimeError):
+    """A worker process of a study's ``processes`` executor died (killed, out of memory): the trials
+    recorded so far are kept, and ``resume=True`` continues the study."""

@@ -35,27 +35,21 @@ beside the paper's numbers as Markdown, :func:`report_rows` as CSV rows::
     run = cheng2019.run_cheng2019(out="results")    # or run_study(load_study("cheng2019"), out=...)
     print(cheng2019.report(run))
 
-From the shell, ``htetro-opt study cheng2019 [--out DIR] [--figures]`` (``--figures`` also saves
-Figs. 8b, 14 and 15, :data:`FIGURES`, drawn from :func:`figure_plans`), or::
-
-    python -m htetro_opt.studies.cheng2019 [--jobs N] [--out DIR]
-
-both of which write ``DIR/cheng2019.md`` and ``DIR/cheng2019.csv`` (replacing the runner's generic
+From the shell, ``htetro-opt study cheng2019 [--workers N] [--out DIR] [--figures]`` (``--figures``
+also saves Figs. 8b, 14 and 15, :data:`FIGURES`, drawn from :func:`figure_plans`), which writes
+``DIR/cheng2019.md`` and ``DIR/cheng2019.csv`` (replacing the runner's generic
 summary of the same names) beside the runner's ``DIR/cheng2019.jsonl`` (every trial). Studies do
 not draw: the command line and the notebook ``05_stripe_coverage`` do.
 """
 
 from __future__ import annotations
 
-import argparse
 import os
-import sys
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 from htetro_opt._files import write_text
-from htetro_opt._validation import check_int
 from htetro_opt.errors import HtetroError, ParameterError
 from htetro_opt.studies.runner import Study, StudyRun, rows_csv
 from htetro_opt.studies.runner import run_study as run_runner_study
@@ -70,7 +64,6 @@ __all__ = [
     "TABLE2_SCENARIO",
     "cheng2019_study",
     "figure_plans",
-    "main",
     "paper_row",
     "report",
     "report_rows",
@@ -595,45 +588,3 @@ def write_report(folder: str | os.PathLike, run: StudyRun, *, figures: Mapping[s
     text = report(run, figures=figures)
     return (write_text(folder / f"{name}.md", text, what="study report"),
             write_text(folder / f"{name}.csv", rows_csv(report_rows(run)), what="study report"))
-
-
-# --- python -m htetro_opt.studies.cheng2019 ----------------------------------------------------------
-def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m htetro_opt.studies.cheng2019 [--small] [--jobs N] [--out DIR] [--resume]``.
-
-    Prints the Markdown report; with ``--out``, writes ``DIR/cheng2019.md``, ``DIR/cheng2019.csv``
-    and the runner's ``DIR/cheng2019.jsonl``. ``--small`` leaves out the larger maps. Figures are
-    drawn by ``htetro-opt study cheng2019 --figures`` (studies do not plot). Returns the exit status
-    (0, or 2 on an error, printed as one ``error:`` line).
-    """
-    parser = argparse.ArgumentParser(prog="python -m htetro_opt.studies.cheng2019",
-                                     description="Cheng et al. 2019's Table 2 and more, the paper's numbers beside "
-                                                 "ours.")
-    parser.add_argument("--small", action="store_true",
-                        help="the paper's two maps only: seconds (tiling_64x64 and indoor_room add about 2 minutes)")
-    parser.add_argument("--jobs", type=int, help="worker processes (1: in this process; default: the cores)")
-    parser.add_argument("--out", metavar="DIR", help="write DIR/cheng2019.md, .csv and the trials' .jsonl")
-    parser.add_argument("--resume", action="store_true", help="keep the trials already in DIR/cheng2019.jsonl")
-    args = parser.parse_args(argv)
-    try:
-        jobs = check_int(args.jobs, "--jobs", minimum=1, allow_none=True)
-        if args.resume and not args.out:
-            raise ParameterError("--resume needs --out DIR, the folder holding the study's results")
-        out = None
-        if args.out:
-            out = Path(args.out)
-            out.mkdir(parents=True, exist_ok=True)
-        executor, workers = ("serial", None) if jobs == 1 else ("processes", jobs)
-        run = run_cheng2019(large=not args.small, executor=executor, workers=workers, out=out, resume=args.resume)
-        print(report(run), end="")
-        if out is not None:
-            md, table = write_report(out, run)
-            print(f"\nwrote {md} and {table}")
-    except (HtetroError, OSError) as err:
-        print("error: " + " ".join(str(err).split()), file=sys.stderr)
-        return 2
-    return 0
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

@@ -34,24 +34,18 @@ out as Markdown, :func:`report_rows` as CSV rows::
     run = do2021.run_do2021(seeds=5, out="results")   # or run_study(load_study("do2021"), out=...)
     print(do2021.report(run, table8=do2021.run_table8(), fig13=do2021.run_fig13()))
 
-From the shell, ``htetro-opt study do2021 [--seeds N] [--out DIR]``, or::
-
-    python -m htetro_opt.studies.do2021 [--tables 6,7,8,13] [--seeds N] [--jobs N] [--out DIR]
-
-both of which write ``DIR/do2021.md`` and ``DIR/do2021.csv`` (the paper's tables: they replace
+From the shell, ``htetro-opt study do2021 [--seeds N] [--workers N] [--out DIR]``, which writes ``DIR/do2021.md`` and ``DIR/do2021.csv`` (the paper's tables: they replace
 the runner's generic summary of the same names, which ``summarise(read_records(DIR/do2021.jsonl))``
 gives back), beside the runner's ``DIR/do2021.jsonl`` (every trial).
 """
 
 from __future__ import annotations
 
-import argparse
 import csv
 import io
 import math
 import numbers
 import os
-import sys
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -59,7 +53,7 @@ from typing import Any
 import numpy as np
 
 from htetro_opt._files import write_text
-from htetro_opt._validation import check_int, check_real
+from htetro_opt._validation import check_real
 from htetro_opt.errors import HtetroError, ParameterError
 from htetro_opt.studies.metrics import format_mean_std, mean_std, values_of
 from htetro_opt.studies.runner import Study, StudyRun
@@ -74,7 +68,6 @@ __all__ = [
     "TABLE6_SCENARIOS",
     "TABLE7_SCENARIOS",
     "TABLES",
-    "main",
     "report",
     "report_rows",
     "run_fig13",
@@ -335,10 +328,11 @@ def _weights_of(row: str) -> tuple[float, ...]:
 
 
 def _kind(record: Mapping[str, Any]) -> str:
-    from htetro_opt.solvers.grid_paths import EXACT_METHODS
+    """A record's method as its family in the grid-path spec: ``heat``, ``exact`` or ``ga``."""
+    from htetro_opt.solvers.grid_paths._spec import SPEC
 
-    method = record.get("method")
-    return "heat" if method == "heat" else "exact" if method in EXACT_METHODS else "ga"
+    family = SPEC.method(record.get("method")).family
+    return next(kind for kind in ("heat", "exact", "ga") if kind in family)
 
 
 def _scored(record: Mapping[str, Any], weights) -> float | None:
@@ -710,51 +704,3 @@ def write_report(folder: str | os.PathLike, run: StudyRun | None = None, *, tabl
     rows = report_rows(run, table8=table8, fig13=fig13)
     return (write_text(folder / f"{name}.md", text, what="study report"),
             write_text(folder / f"{name}.csv", _csv(rows), what="study report"))
-
-
-# --- python -m htetro_opt.studies.do2021 -----------------------------------------------------------
-def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m htetro_opt.studies.do2021 [--tables 6,7,8,13] [--seeds N] [--jobs N] [--out DIR]``.
-
-    Prints the Markdown report; with ``--out``, writes ``DIR/do2021.md``, ``DIR/do2021.csv`` and the
-    runner's ``DIR/do2021.jsonl``. ``--jobs 1`` runs the trials in this process, more on a process
-    pool (default: the machine's cores). Returns the exit status (0, or 2 on an error, printed as one
-    ``error:`` line).
-    """
-    parser = argparse.ArgumentParser(prog="python -m htetro_opt.studies.do2021",
-                                     description="Do et al. 2021's Tables 6-8 and Fig. 13, the paper's numbers "
-                                                 "beside ours.")
-    parser.add_argument("--tables", default="6,7,8,13", help="which to run, comma-separated (default 6,7,8,13)")
-    parser.add_argument("--seeds", type=int, default=5, help="the GA's seeds 0 … N−1 (default 5; the paper: 50)")
-    parser.add_argument("--jobs", type=int, help="worker processes (1: in this process; default: the cores)")
-    parser.add_argument("--out", metavar="DIR", help="write DIR/do2021.md, .csv and the trials' .jsonl")
-    parser.add_argument("--resume", action="store_true", help="keep the trials already in DIR/do2021.jsonl")
-    args = parser.parse_args(argv)
-    try:
-        tables = _check_tables(args.tables)
-        seeds = check_int(args.seeds, "--seeds", minimum=1)
-        jobs = check_int(args.jobs, "--jobs", minimum=1, allow_none=True)
-        if args.resume and not args.out:
-            raise ParameterError("--resume needs --out DIR, the folder holding the study's results")
-        out = None
-        if args.out:
-            out = Path(args.out)
-            out.mkdir(parents=True, exist_ok=True)
-        run = None
-        if 6 in tables or 7 in tables:
-            executor, workers = ("serial", None) if jobs == 1 else ("processes", jobs)
-            run = run_do2021(seeds, tables=tables, executor=executor, workers=workers, out=out, resume=args.resume)
-        table8 = run_table8() if 8 in tables else None
-        fig13 = run_fig13() if 13 in tables else None
-        print(report(run, table8=table8, fig13=fig13), end="")
-        if out is not None:
-            md, table = write_report(out, run, table8=table8, fig13=fig13)
-            print(f"\nwrote {md} and {table}")
-    except (HtetroError, OSError) as err:
-        print("error: " + " ".join(str(err).split()), file=sys.stderr)
-        return 2
-    return 0
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

@@ -52,8 +52,10 @@ from htetro_opt._validation import check_int, check_time_limit
 from htetro_opt.errors import ParameterError, TilingError
 from htetro_opt.model.coverage import simulate_coverage
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, path_cost
-from htetro_opt.scenarios import Tileset, list_scenarios, list_tilesets, load_scenario, load_tileset, tileset_path
+from htetro_opt.scenarios import Tileset, load_scenario, load_tileset, tileset_path
 from htetro_opt.solvers.sequencing import sequence_waypoints
+from htetro_opt.solvers.sequencing._spec import SPEC as SEQUENCING
+from htetro_opt.solvers.sequencing._spec import is_tileset
 from htetro_opt.solvers.tiling import tile_workspace
 from htetro_opt.studies.metrics import format_mean_std, mean_std
 from htetro_opt.studies.runner import Study, StudyRun
@@ -70,7 +72,6 @@ __all__ = [
     "TABLE1_METHODS",
     "TABLE1_SCENARIOS",
     "TABLE2_SCENARIOS",
-    "STOCHASTIC",
     "le2018_study",
     "run_le2018",
     "report",
@@ -91,7 +92,6 @@ PAPER_TABLE1 = {  # method: (cost weight, path generating time s), 11 x 11, 28 w
     "ga-plain": (62.368, 1.150),
 }
 TABLE1_METHODS = ("zigzag", "zigzag2", "spiral", "spiral2", "greedy", "ga-plain", "ga", "ortools", "local", "exact")
-STOCHASTIC = ("greedy", "ga-plain", "ga")
 TABLE1_SCENARIOS = ("paper_11x11_fig13d", "tiling_11x11")
 """Table 1's maps: the paper's 11 × 11 tileset and our tiling of its map (tiled first, by the tile task's default method)."""
 TABLE2_SCENARIOS = ("paper_10x10_fig13c",)
@@ -156,7 +156,8 @@ def run_table1(tileset: Tileset, *, seeds: Iterable[int] = (0,), methods: Sequen
                time_limit: float | None = None) -> list[dict]:
     """Every method on one tileset from tile 1: one record per (method, seed), with the gap to the optimum.
 
-    Deterministic methods run once (seed 0). ``time_limit`` caps each method that takes one.
+    A method that does not draw from the seed (the sequencing spec says which) runs once, seed 0.
+    ``time_limit`` caps each method that takes one.
     """
     seeds = _check_seeds(seeds)
     time_limit = check_time_limit(time_limit)
@@ -164,9 +165,12 @@ def run_table1(tileset: Tileset, *, seeds: Iterable[int] = (0,), methods: Sequen
     optimum = sequence_waypoints(instance, method="exact")
     records = []
     for method in methods:
-        for seed in (seeds if method in STOCHASTIC else [0]):
-            result = optimum if method == "exact" else sequence_waypoints(instance, method=method, seed=seed,
-                                                                          time_limit=time_limit)
+        chosen = SEQUENCING.method(method)
+        for seed in (seeds if chosen.draws() else [0]):
+            options = {"seed": seed} if chosen.takes("seed") else {}
+            if time_limit is not None and chosen.takes("time_limit"):
+                options["time_limit"] = time_limit
+            result = optimum if method == "exact" else sequence_waypoints(instance, method=method, **options)
             records.append({
                 "table": 1, "tileset": tileset.name, "method": method, "seed": seed, "cost": result.cost,
                 "runtime_s": result.runtime_s, "optimum": optimum.cost,
@@ -336,7 +340,7 @@ def le2018_study(seeds: int | Sequence[int] = 5, *, methods: Sequence[str] = TAB
     Parameters
     ----------
     seeds : int or sequence of int
-        N for seeds 0 … N−1, or the seeds (the stochastic methods, :data:`STOCHASTIC`, run once per seed).
+        N for seeds 0 … N−1, or the seeds (the methods that draw from the seed run once per seed).
     methods : sequence of str, keyword-only
         Table 1's methods, one entry each, labelled by the method's name.
     weights : bool, keyword-only
@@ -366,7 +370,9 @@ def le2018_study(seeds: int | Sequence[int] = 5, *, methods: Sequence[str] = TAB
         raise ParameterError(f"methods must be a list of sequencing methods, got {methods!r}")
     time_limit = check_time_limit(time_limit)
     cap = {} if time_limit is None else {"time_limit": time_limit}
-    entries: list[dict[str, Any]] = [{"method": m, **({} if m == "exact" else cap)} for m in methods]
+    # the cap on each heuristic that takes one (the exact solver keeps its own: it proves the optimum)
+    entries: list[dict[str, Any]] = [{"method": m, **(cap if m != "exact" and SEQUENCING.method(m).takes("time_limit")
+                                                       else {})} for m in methods]
     if weights:
         entries += [{"label": f"exact, weights {_weights_label(w)}", "method": "exact", "weights": list(w)}
                     for w, *_ in PAPER_TABLE2]
@@ -393,20 +399,12 @@ def run_le2018(seeds: int | Sequence[int] = 5, *, methods: Sequence[str] = TABLE
     return run_runner_study(study, out=out, executor=executor, workers=workers, resume=resume, progress=progress)
 
 
-def _is_tileset(scenario: str) -> bool:
-    """The runner's rule for ``sequence``: a bundled tileset or a non-``.toml`` file is a labelled
-    tileset, a bundled map or a ``.toml`` file a map tiled first."""
-    if scenario.endswith(".toml"):
-        return False
-    return scenario in list_tilesets() or scenario not in list_scenarios()
-
-
 def _tileset(scenario: str, shapes: str | None) -> Tileset:
     """The tileset a ``sequence`` trial on ``scenario`` ordered, named as the report names it (the
     tiling without shuffle is deterministic, so this is the trial's)."""
     if scenario in PAPER_TILESETS:
         return paper_tileset(scenario)
-    if _is_tileset(scenario):
+    if is_tileset(scenario):
         return load_tileset(tileset_path(scenario))
     workspace = load_scenario(scenario).workspace
     result = tile_workspace(workspace, shapes=list(shapes) if shapes else None)  # the sequence task's tiler

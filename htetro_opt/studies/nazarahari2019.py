@@ -14,14 +14,13 @@ seed. The trials run on worker processes (``jobs``, default the local cores). A 
 ``htetro-opt study nazarahari2019`` runs) took 14 minutes on 2 cores under a load average of 5–9
 from other work (benchmarks/results/nazarahari2019).
 
-``python -m htetro_opt.studies.nazarahari2019 [--seeds N] [--out DIR] [--rrt-time-limit S] [--pair-seeds N]
-[--no-pairs] [--jobs N]`` (``htetro-opt study nazarahari2019`` runs the defaults) prints the report;
-``--out`` writes DIR/nazarahari2019.md and DIR/nazarahari2019.csv.
+``htetro-opt study nazarahari2019 [--seeds N] [--workers N] [--out DIR]`` runs it with the defaults
+(:func:`run_nazarahari2019` takes the rest: the maps, methods, pairs, B-RRT's time limit) and prints the
+report; ``--out`` writes DIR/nazarahari2019.md and DIR/nazarahari2019.csv.
 """
 
 from __future__ import annotations
 
-import argparse
 import csv
 import io
 import os
@@ -483,27 +482,3 @@ def write_report(folder, run: Run) -> tuple[Path, Path]:
             writer.writerow(["pairs", r["map"], r["pair"], r["seed"], r["reached"], f"{r['length']:.6f}",
                              f"{r['smoothness']:.4f}", f"{r['runtime']:.4f}"])
     return md, table
-
-
-def main(argv=None) -> int:
-    """``python -m htetro_opt.studies.nazarahari2019 [--seeds N] [--out DIR] [--rrt-time-limit S] [--pair-seeds N]
-    [--no-pairs] [--jobs N]``."""
-    parser = argparse.ArgumentParser(prog="python -m htetro_opt.studies.nazarahari2019",
-                                     description="Nazarahari et al. 2019's Table 2, §5.1, §5.3 and four robots")
-    parser.add_argument("--seeds", type=int, default=5, help="seeds 0 … N−1 (default 5; the paper: 50)")
-    parser.add_argument("--out", help="write DIR/nazarahari2019.md and .csv")
-    parser.add_argument("--rrt-time-limit", type=float, help="B-RRT seconds per run (default 120)")
-    parser.add_argument("--pair-seeds", type=int, default=1, help="run §5.1's pairs on the first N seeds (default 1)")
-    parser.add_argument("--no-pairs", action="store_true", help="skip §5.1's (IS, PS) pairs")
-    parser.add_argument("--jobs", type=int, help="worker processes (default: the local cores; 1: this process)")
-    args = parser.parse_args(argv)
-    run = run_nazarahari2019(args.seeds, rrt_time_limit=args.rrt_time_limit, pairs=() if args.no_pairs else PAIRS,
-                             pair_seeds=args.pair_seeds, jobs=args.jobs)
-    print(report(run), end="")
-    if args.out:
-        write_report(args.out, run)
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

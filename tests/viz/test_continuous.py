@@ -8,7 +8,7 @@ from PIL import Image
 
 from htetro_opt.errors import ParameterError
 from htetro_opt.scenarios import load_scenario, parse_scenario
-from htetro_opt.solvers.continuous import CONTINUOUS_METHODS, plan_continuous
+from htetro_opt.solvers.continuous import SPEC, plan_continuous
 from htetro_opt.viz import plot_apf_potential, plot_continuous, plot_continuous_front, save_figure
 
 SMALL = {"prm": {"seed": 0}, "rrt": {"seed": 0, "time_limit": 0.2}, "pso": {"seed": 0, "pop_size": 6, "max_gen": 3},
@@ -37,7 +37,7 @@ def assert_paths_drawn(ax, plan, p=0):
             assert not lines  # a robot that did not reach its goal has no line
 
 
-@pytest.mark.parametrize("method, name", [(m, "ega07_slits1") for m in CONTINUOUS_METHODS]
+@pytest.mark.parametrize("method, name", [(m, "ega07_slits1") for m in SPEC.methods]
                          + [("ega", "ega_cross4"), ("pso", "ega_cross4")])
 def test_every_method_s_plan_is_drawn_and_saved(method, name, tmp_path):
     sc = load_scenario(name)
@@ -60,7 +60,7 @@ def test_plans_with_a_robot_short_of_its_goal_are_drawn_and_say_so(tmp_path):
     boxed, free = {"start": [1, 5], "goal": [7.5, 8]}, {"start": [1, 1], "goal": [9, 2]}
     first_boxed = parse_scenario({**walled, "robots": [boxed, free]})
     alone = parse_scenario({**walled, "robots": [boxed]})
-    for method in CONTINUOUS_METHODS:
+    for method in SPEC.methods:
         plan = plan_continuous(first_boxed, method=method, **SMALL.get(method, {}))
         assert plan.robots_reached == (False, True), method
         ax = plot_continuous(first_boxed, plan).axes[0]

@@ -104,7 +104,7 @@ METHODS = (
 )
 
 
-def _pose(scenario, *, robot_radius=None) -> Problem:
+def _pose(scenario, *, label, robot_radius) -> Problem:
     """A continuous scenario (a bundled name, a file or a loaded one), with another robot radius if given."""
     from htetro_opt.scenarios import ContinuousScenario, load_scenario
 
@@ -119,6 +119,6 @@ def _pose(scenario, *, robot_radius=None) -> Problem:
 SPEC = TaskSpec(
     "continuous planning", package="htetro_opt.solvers.continuous", entry="._dispatch:plan_continuous",
     options=OPTIONS, methods=METHODS, default="exact", exact="exact",
-    families={"ga": "the GA methods"}, pose=_pose,
+    families={"ga": "the GA methods"}, common=("robot_radius",), pose=_pose,
 )
 """The continuous-path task (see the module docstring)."""

@@ -93,8 +93,7 @@ OPTIONS = (
 )
 
 _PAPER = "Cheng et al. 2019"
-_STRIPES = ("clearance", "stripes", "region_columns", "budget", "ends", "mopup", "memo", "time_limit",
-            "shapes", "start")
+_STRIPES = ("stripes", "region_columns", "budget", "ends", "mopup", "memo", "time_limit")
 
 METHODS = (
     Method("stripes", "._stripes:plan_stripes", "the paper's stripes, regions and auxiliary DAG, with our "
@@ -102,13 +101,13 @@ METHODS = (
     Method("stripes-paper", "._stripes:plan_stripes", "its Alg. 5 (simple paths, cuts at forced poses)", _STRIPES,
            presets={"paper": True}, origin="paper", paper=_PAPER, family=("stripes",)),
     Method("boustrophedon", "._baselines:boustrophedon_path", "lanes in the first layer (a baseline)",
-           ("clearance", "mopup", "shapes", "start"), origin="baseline", paper=_PAPER),
+           ("mopup",), origin="baseline", paper=_PAPER),
     Method("tiling-tsp", "._baselines:tiling_tsp_tokens", "tile with the shapes, order the tiles, drive through "
-           "them (a baseline)", ("clearance", "time_limit", "shapes", "start"), origin="baseline", paper=_PAPER),
+           "them (a baseline)", ("time_limit",), origin="baseline", paper=_PAPER),
 )
 
 
-def _pose(scenario, *, shapes=",".join(DEFAULT_LAYERS), start="scenario") -> Problem:
+def _pose(scenario, *, label, shapes, start) -> Problem:
     """A grid scenario's map and the morphology layers; with ``start="scenario"`` its roadmap's first and
     last poses as the plan's start and goal (a free start and end when it has none)."""
     from htetro_opt.scenarios import Scenario, load_scenario
@@ -124,7 +123,8 @@ def _pose(scenario, *, shapes=",".join(DEFAULT_LAYERS), start="scenario") -> Pro
 
 SPEC = TaskSpec(
     "coverage", package="htetro_opt.solvers.coverage", entry="._dispatch:plan_coverage", options=OPTIONS,
-    methods=METHODS, default="stripes", families={"stripes": "the stripes methods"}, pose=_pose,
+    methods=METHODS, default="stripes", families={"stripes": "the stripes methods"},
+    common=("shapes", "start", "clearance"), pose=_pose,
 )
 """The coverage task (see the module docstring). It has no exact method: a study measures a plan
 against its lower bound on the action cost instead."""

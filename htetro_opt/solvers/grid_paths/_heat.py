@@ -70,9 +70,11 @@ from htetro_opt.problems.heat_costs import check_heat_weights, default_t_max, he
 from htetro_opt.solvers.grid_paths._exact import _GRAPH_BYTES, _check_memory, _Graph
 from htetro_opt.solvers.grid_paths._heat_field import solve_heat_field
 from htetro_opt.solvers.grid_paths._result import Plan, check_map, check_roadmap, finish_plan, prepare
-from htetro_opt.solvers.grid_paths._spec import BAND_SEEDS, HEAT_ELEMENTS, HEAT_ENGINES
+from htetro_opt.solvers.grid_paths._spec import BAND_SEEDS, HEAT_ELEMENTS, HEAT_ENGINES, SPEC
 
 __all__ = ["plan_heat", "BAND_AUTO_POSES", "BAND_AUTO_RADIUS"]
+
+_DEFAULTS = SPEC.defaults("heat")  # the task's defaults, declared once in its spec
 
 BAND_AUTO_POSES = 4_000_000
 """``band="auto"`` searches the whole pose graph up to this many poses, and a band above."""
@@ -375,18 +377,18 @@ def plan_heat(
     workspace: Workspace | Simulator,
     roadmap: Sequence[Pose],
     *,
-    weights=(1.0, 0.0, 0.0),
+    weights=_DEFAULTS["weights"],
     t_max: float | None = None,
-    element: str = "q1",
-    monotone: bool = True,
-    band: str | int = "auto",
-    band_seed: str = "ascent",
-    engine: str = "dijkstra",
+    element: str = _DEFAULTS["element"],
+    monotone: bool = _DEFAULTS["monotone"],
+    band: str | int = _DEFAULTS["band"],
+    band_seed: str = _DEFAULTS["band_seed"],
+    engine: str = _DEFAULTS["engine"],
     commands: Sequence[str] | None = None,
     timing: Timing | None = None,
-    clearance: float = 0.0,
+    clearance: float = _DEFAULTS["clearance"],
     field_options: Mapping | None = None,
-    keep_fields: bool = False,
+    keep_fields: bool = _DEFAULTS["keep_fields"],
 ) -> Plan:
     """Do et al. 2021's heat-conduction plan through a roadmap: climb each leg's temperature field.
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from htetro_opt.algorithms.names import PICKS
 from htetro_opt.errors import ParameterError, PlanningError
 from htetro_opt.model.commands import COMMANDS
 from htetro_opt.model.robot import Pose, as_pose
@@ -136,8 +137,30 @@ class Plan(Result):
         out = {"reached": bool(self.reached), "commands": self.tokens, "time": float(self.time),
                "objectives": self.objectives(), "leg_ends": list(self.leg_ends), "failed_leg": self.failed_leg}
         if self.legs:
-            out["reach_generation"] = self.reach_generation
-            out["generations"] = sum(leg.generations for leg in self.legs)
+            out.update(self._ga_fields())
+        return out
+
+    def _ga_fields(self) -> dict:
+        """The GAs' fields: every leg's record, the last leg's front, the picked solution's fitnesses
+        (averaged over the legs) and, when each leg's exact optimum is known (``seed_exact``), the gaps of
+        the plan and of the legs' fastest members to it."""
+        pick = self.info.get("pick", "balanced")
+        legs = [{"start": leg.start.as_dict(), "goal": leg.goal.as_dict(), "reached": leg.reached,
+                 "reach_generation": leg.reach_generation, "generations": leg.generations,
+                 "converged": leg.converged, "runtime_s": round(leg.runtime_s, 6),
+                 "selected": {name: member.as_dict() for name, member in leg.selected.items()},
+                 "front": [member.as_dict() for member in leg.front]} for leg in self.legs]
+        fitness = np.mean([leg.selected[PICKS[pick]].fitness for leg in self.legs], axis=0)
+        out = {"pick": pick, "reach_generation": self.reach_generation,
+               "generations": sum(leg.generations for leg in self.legs),
+               "fitness": {name: float(v) for name, v in zip(FITNESS_NAMES, fitness)},
+               "front": legs[-1]["front"], "legs": legs}
+        exact = self.info.get("exact_times")
+        if exact is not None and self.reached and None not in exact and sum(exact) > 0:
+            # each leg's optimum from where and when the returned plan starts it
+            fastest = sum(leg.selected["time"].time for leg in self.legs)
+            out["gap"] = {"exact": float(sum(exact)), "picked": (self.time - sum(exact)) / sum(exact),
+                          "fastest": (fastest - sum(exact)) / sum(exact)}
         return out
 
     @property

@@ -185,7 +185,7 @@ METHODS = (
 )
 
 
-def _pose(scenario, *, sensor_range=None) -> Problem:
+def _pose(scenario, *, label, sensor_range) -> Problem:
     """A grid scenario's map and roadmap (a bundled name, a file or a loaded Scenario)."""
     from htetro_opt.scenarios import Scenario, load_scenario
 
@@ -205,7 +205,8 @@ def _solve(spec: TaskSpec, problem: Problem, method, options: dict):
         return spec.entry_point()(*problem.args, method=method, **options)
     from htetro_opt.solvers.grid_paths._replan import replan_heat
 
-    options = spec.check(method, options)
+    # the options given only: replan_heat treats a given band apart (it hands plan_heat the map, not its simulator)
+    options = spec.check(method, options, stage="method", fill=False)
     return replan_heat(problem.scenario, sensor_range=sensor_range, **options).as_plan()
 
 
@@ -214,6 +215,6 @@ SPEC = TaskSpec(
     methods=METHODS, default="dijkstra", exact="dijkstra", aliases={"exact": "dijkstra"},
     families={"exact": "the exact methods", "ga": "the GA methods", "htetro-ga": "the hTetro-GA methods",
               "pymoo": "pymoo's algorithms", "heat": "the heat planner"},
-    pose=_pose, solve=_solve,
+    common=_SIMULATOR, pose=_pose, solve=_solve,
 )
 """The grid-path task (see the module docstring)."""

@@ -10,11 +10,14 @@ every answer. Importing the spec loads no scipy, numba, OR-Tools or DEAP.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from htetro_opt._spec import Method, Option, Problem, TaskSpec, seed_option
 from htetro_opt._validation import check_bool, check_int, check_probability, check_real, check_time_limit
 from htetro_opt.errors import ParameterError
+from htetro_opt.solvers.sequencing._budgets import TIME_LIMIT_TEXT
 
-__all__ = ["SPEC", "EXACT_AUTO_LIMIT", "EXACT_MAX_SIZE", "EXACT_TIME_LIMIT", "FAST_TSP_CANDIDATES",
+__all__ = ["SPEC", "is_tileset", "EXACT_AUTO_LIMIT", "EXACT_MAX_SIZE", "EXACT_TIME_LIMIT", "FAST_TSP_CANDIDATES",
            "FIRST_SOLUTIONS", "ILS_NEIGHBOURS"]
 
 EXACT_AUTO_LIMIT = 40
@@ -126,7 +129,7 @@ OPTIONS = (
     # the methods' own
     seed_option(),
     Option("time_limit", check_time_limit, "time budget in seconds", type=float, metavar="S",
-           default_text="sized to the instance (see sequencing's default_time_limit)"),
+           default_text=f"sized to the instance: {TIME_LIMIT_TEXT}"),
     Option("progress", _callback, "progress(done, total, note) from the methods that report", flag="",
            study=False),
     Option("restarts", _int(0), "kicks of the iterated local search", default=0, type=int, metavar="N"),
@@ -163,18 +166,20 @@ _GA = ("seed", "time_limit", "progress", "pop_size", "max_gen", "patience", "cro
 _PATTERN = dict(capabilities={"asymmetric", "geometry"}, origin="baseline", paper=_PAPER, family=("pattern",))
 
 METHODS = (
+    # auto runs exact, ils or ortools (auto_method): it takes their options and hands each the ones it takes
     Method("auto", None, f"exact up to {EXACT_AUTO_LIMIT} waypoints, ils beyond (ortools for asymmetric costs)",
-           ("seed", "time_limit", "progress"), seeded=True, capabilities={"asymmetric", "tours", "implicit"}),
+           ("seed", "time_limit", "progress", "max_size", "kicks", "neighbours", "scale", "first_solution"),
+           seeded=True, capabilities={"asymmetric", "tours", "implicit"}),
     Method("exact", "._exact:solve_exact", f"the CP-SAT optimum with a proof (<= {EXACT_MAX_SIZE} waypoints)",
            ("time_limit", "max_size"), exact=True, origin="reference", capabilities={"asymmetric"}),
     Method("ortools", "._ortools:solve_ortools", "OR-Tools routing with guided local search (the paper's baseline)",
            ("time_limit", "progress", "scale", "first_solution"), origin="baseline", paper=_PAPER,
            capabilities={"asymmetric", "progress"}),
-    Method("ils", "._ils:solve_ils", "the compiled, seeded iterated local search (2-opt, Or-opt, double-bridge "
-           "kicks)", ("seed", "time_limit", "kicks", "neighbours"), seeded=True, capabilities={"tours", "implicit"}),
     Method("local", "._local:solve_local", "nearest neighbour + 2-opt/Or-opt, iterated with --restarts",
            ("seed", "time_limit", "progress", "restarts", "max_starts"),
            seeded=lambda options: options.get("restarts", 0) > 0, capabilities={"progress"}),
+    Method("ils", "._ils:solve_ils", "the compiled, seeded iterated local search (2-opt, Or-opt, double-bridge "
+           "kicks)", ("seed", "time_limit", "kicks", "neighbours"), seeded=True, capabilities={"tours", "implicit"}),
     Method("ga", "._ga:solve_ga", "the paper's GA on DEAP with a 2-opt/Or-opt step (memetic, ours)",
            (*_GA, "local_search_rate"), defaults={"patience": 50}, presets={"memetic": True}, seeded=True,
            paper=_PAPER, family=("ga",), capabilities={"progress"}),
@@ -193,56 +198,66 @@ METHODS = (
 )
 
 
-def _pose(source, *, start=1, end=None, closed=None, weights=(0.25,) * 4, shapes=None) -> Problem:
+def _pose(source, *, label, start, end, closed, weights, shapes) -> Problem:
     """A labelled tileset, a grid scenario (tiled first, by ``tile``'s default method) or a TSPLIB file as a
     :class:`~htetro_opt.problems.SequencingInstance`: tilesets open paths, TSPLIB files closed tours."""
-    from dataclasses import replace
-
     from htetro_opt.problems import SequencingInstance
 
     kind, loaded = _source(source)
     if kind == "tsplib":
-        for name, given in (("weights", tuple(weights) != (0.25,) * 4), ("shapes", shapes is not None)):
+        untiled = (("weights", tuple(weights) != SPEC.options["weights"].default), ("shapes", shapes is not None))
+        for name, given in untiled:
             if given:
-                raise ParameterError(f"{name} does not apply to a TSPLIB file (it has no tiles)")
+                raise ParameterError(f"{label(name)} does not apply to a TSPLIB file (it has no tiles)")
         closed = True if closed is None else closed
         if closed and end is not None:
-            raise ParameterError("end applies to open paths (a TSPLIB file is a closed tour unless asked open)")
+            raise ParameterError(f"{label('end')} applies to open paths (a TSPLIB file is a closed tour unless asked "
+                                 "for an open path)")
         nodes = range(1, loaded.dimension + 1)
-        instance = SequencingInstance.from_matrix(loaded.cost, closed=closed, start=_index(start, nodes, "start", "node"),
-                                                  end=_index(end, nodes, "end", "node"))
+        instance = SequencingInstance.from_matrix(loaded.cost, closed=closed,
+                                                  start=_index(start, nodes, label("start"), "node"),
+                                                  end=_index(end, nodes, label("end"), "node"))
         return Problem(loaded.name, (instance,), scenario=loaded, extras={"instance": instance, "tsplib": loaded})
     if kind == "tileset":
         if shapes is not None:
-            raise ParameterError("shapes applies only to a scenario to tile, not to a labelled tileset")
+            raise ParameterError(f"{label('shapes')} applies only to a scenario to tile, not to a labelled tileset")
         tileset = loaded
     else:
         from htetro_opt.solvers.tiling import tile_workspace
 
         tileset = tile_workspace(loaded.workspace, shapes=shapes, name=loaded.name).tileset
     if start != "free":
-        _index(start, tileset.ids, "start", "tile")  # from_tileset takes the label itself
+        _index(start, tileset.ids, label("start"), "tile")  # from_tileset takes the label itself
     instance = SequencingInstance.from_tileset(tileset, start=None if start == "free" else start, weights=weights)
     if closed or end is not None:
-        instance = replace(instance, closed=bool(closed), end=_index(end, instance.ids, "end", "tile"))
+        instance = replace(instance, closed=bool(closed), end=_index(end, instance.ids, label("end"), "tile"))
     return Problem(tileset.name, (instance,), scenario=loaded, extras={"instance": instance, "tileset": tileset})
 
 
-def _index(label, ids, name: str, what: str):
-    """The index of tile (node) ``label`` among ``ids``; None for None or "free"."""
-    if label is None or label == "free":
+def _index(tile, ids, name: str, what: str):
+    """The index of tile (node) ``tile`` among ``ids``; None for None or "free"."""
+    if tile is None or tile == "free":
         return None
     ids = list(ids)
-    if label not in ids:
-        raise ParameterError(f"{name} {label}: there is no {what} {label}")
-    return ids.index(label)
+    if tile not in ids:
+        raise ParameterError(f"{name} {tile}: there is no {what} {tile}")
+    return ids.index(tile)
+
+
+def is_tileset(name: str) -> bool:
+    """``sequence``'s rule for a name: a ``.toml`` file or a bundled scenario is a scenario to tile first; a
+    TSPLIB file (.tsp, .atsp) is an instance of its own; any other name a labelled tileset (bundled or a file)."""
+    from htetro_opt.scenarios import list_scenarios, list_tilesets
+
+    if name.lower().endswith((".tsp", ".atsp", ".toml")):
+        return False
+    return name in list_tilesets() or name not in list_scenarios()
 
 
 def _source(source):
     """(kind, loaded): a TSPLIB file (.tsp, .atsp), a labelled tileset (a bundled name or any other file) or a
     grid scenario (a bundled scenario name, a .toml file or a loaded Scenario)."""
-    from htetro_opt.scenarios import Scenario, Tileset, list_scenarios, list_tilesets, load_scenario, load_tileset
-    from htetro_opt.scenarios import scenario_path, tileset_path
+    from htetro_opt.scenarios import Scenario, Tileset, load_scenario, load_tileset, scenario_path, tileset_path
 
     if isinstance(source, Tileset):
         return "tileset", source
@@ -254,7 +269,7 @@ def _source(source):
         from htetro_opt.scenarios.tsplib import load_tsplib
 
         return "tsplib", load_tsplib(source)
-    if source.endswith(".toml") or (source not in list_tilesets() and source in list_scenarios()):
+    if not is_tileset(source):
         scenario_path(source)  # a clear error for a missing file
         from htetro_opt.errors import ScenarioError
 
@@ -268,6 +283,7 @@ def _source(source):
 SPEC = TaskSpec(
     "sequencing", package="htetro_opt.solvers.sequencing", entry="._dispatch:sequence_waypoints", options=OPTIONS,
     methods=METHODS, default="auto", exact="exact",
-    families={"ga": "the GA methods", "pattern": "the pattern baselines"}, pose=_pose,
+    families={"ga": "the GA methods", "pattern": "the pattern baselines"},
+    common=tuple(option.name for option in OPTIONS if option.stage == "problem"), pose=_pose,
 )
 """The sequencing task (see the module docstring)."""

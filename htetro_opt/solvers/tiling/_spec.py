@@ -72,7 +72,7 @@ METHODS = (
 )
 
 
-def _pose(scenario) -> Problem:
+def _pose(scenario, *, label) -> Problem:
     """A grid scenario's map, the tileset named after it."""
     from htetro_opt.scenarios import Scenario, load_scenario
 

@@ -16,7 +16,7 @@ from htetro_opt.model import SEED004_COMMANDS, STATE_NAMES, Pose, Simulator, Wor
 from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers import plan_coverage
 from htetro_opt.solvers.coverage import (
-    COVERAGE_METHODS,
+    SPEC,
     LayerGraph,
     parse_layers,
     stripe_graph,
@@ -179,7 +179,7 @@ def test_no_pose_fits_anywhere():
 def test_plans_are_valid_and_cover_every_coverable_cell(ws, data):
     layers = data.draw(st.lists(st.sampled_from(LAYER_TOKENS), min_size=1, max_size=3, unique=True))
     width = data.draw(st.integers(2, 4))
-    method = data.draw(st.sampled_from(COVERAGE_METHODS))
+    method = data.draw(st.sampled_from(tuple(SPEC.methods)))
     try:
         plan = plan_coverage(ws, layers, method=method, stripes=min(width, ws.height))
     except TilingError:  # the baseline needs a tiling of every free cell

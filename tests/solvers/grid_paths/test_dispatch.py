@@ -5,15 +5,15 @@ import pytest
 
 from htetro_opt.errors import ParameterError, PlanningError, UnknownCommandError
 from htetro_opt.model import Pose, Simulator, Workspace, parse_commands
-from htetro_opt.solvers.grid_paths import EXACT_METHODS, PLAN_METHODS, Plan, plan_path
+from htetro_opt.solvers.grid_paths import EXACT_METHODS, SPEC, Plan, plan_path
 
 OPEN = Workspace(np.zeros((8, 8), dtype=bool))
 START, MID, GOAL = Pose(1, 1, "O", 0), Pose(3, 1, "O", 0), Pose(3, 3, "O", 0)
 
 
 def test_method_names():
-    assert set(EXACT_METHODS) < set(PLAN_METHODS)
-    assert PLAN_METHODS[2:] == ("htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea", "heat")
+    assert set(EXACT_METHODS) < set(SPEC.methods)
+    assert tuple(SPEC.methods)[2:] == ("htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea", "heat")
 
 
 @pytest.mark.parametrize("method", EXACT_METHODS)

@@ -18,6 +18,7 @@ from htetro_opt.problems.waypoint_sequencing import SequencingInstance, cost_mat
 from htetro_opt.scenarios import load_tileset, tileset_path
 from htetro_opt.solvers.sequencing import (
     ASYMMETRIC_METHODS,
+    SPEC,
     auto_method,
     held_karp,
     sequence_waypoints,
@@ -30,6 +31,11 @@ from htetro_opt.solvers.sequencing import (
 MATRIX_METHODS = {"exact": {}, "ortools": {"time_limit": 0.2}, "local": {"restarts": 5}, "ga": {"patience": 5},
                   "ga-plain": {"max_gen": 30}, "greedy": {"iterations": 30}, "fast-tsp": {"time_limit": 0.2},
                   "lkh": {}}
+
+
+def options_of(method, seed=0):
+    """A call's options: this file's budget, and the seed where the method takes one (the spec says which)."""
+    return {**MATRIX_METHODS[method], **({"seed": seed} if SPEC.method(method).takes("seed") else {})}
 
 
 def priced(cost, order, closed):
@@ -73,7 +79,7 @@ def test_no_method_beats_the_proved_optimum_and_every_order_is_valid(method, clo
     optimum = sequence_waypoints(inst, method="exact")
     assert optimum.info["optimal"]
     assert optimum.info["bound"] <= optimum.cost + 1e-9
-    result = sequence_waypoints(inst, method=method, seed=0, **MATRIX_METHODS[method])
+    result = sequence_waypoints(inst, method=method, **options_of(method))
     assert_valid(inst, result)
     assert result.cost >= optimum.cost - 1e-6
 
@@ -124,7 +130,7 @@ def test_asymmetric_costs_are_priced_in_the_travelled_direction(method):
     for closed, start, end in ((True, 0, None), (False, 2, 6), (False, None, None)):
         inst = SequencingInstance.from_matrix(cost, closed=closed, start=start, end=end)
         optimum = sequence_waypoints(inst, method="exact").cost
-        result = sequence_waypoints(inst, method=method, seed=0, **MATRIX_METHODS[method])
+        result = sequence_waypoints(inst, method=method, **options_of(method))
         assert_valid(inst, result)
         assert result.cost >= optimum - 1e-6
         if method in ("exact", "lkh"):
@@ -282,10 +288,14 @@ def test_negative_costs_are_shifted_not_refused():
     assert sequence_waypoints(inst, method="lkh").cost == pytest.approx(optimum, abs=1e-3)
 
 
-def test_lkh_is_deterministic_and_refuses_a_time_limit():
+def test_lkh_is_deterministic_and_refuses_a_seed_and_a_time_limit():
     inst = SequencingInstance.from_matrix(euclidean(60, 9), start=4)
-    first = sequence_waypoints(inst, method="lkh", seed=1).order.tolist()
-    assert sequence_waypoints(inst, method="lkh", seed=2).order.tolist() == first  # LKH's own fixed seed
+    first = sequence_waypoints(inst, method="lkh").order.tolist()
+    assert sequence_waypoints(inst, method="lkh").order.tolist() == first  # LKH's own fixed seed
+    assert solve_lkh(inst, seed=2)[0].tolist() == first
+    for option in ("seed", "time_limit"):  # the spec's lkh draws from no seed and takes no limit
+        with pytest.raises(ParameterError, match=f"{option} applies to .* only, not to lkh"):
+            sequence_waypoints(inst, method="lkh", **{option: 1})
     with pytest.raises(ParameterError, match="takes no time limit"):
         solve_lkh(inst, time_limit=1.0)
     with pytest.raises(ParameterError, match="runs must be a positive integer"):

@@ -10,7 +10,7 @@ from htetro_opt.errors import ParameterError, PlanningError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, cost_matrix
 from htetro_opt.scenarios import load_tileset, tileset_path
 from htetro_opt.solvers.sequencing import (
-    SEQUENCE_METHODS,
+    SPEC,
     SequenceResult,
     sequence_waypoints,
     solve_exact,
@@ -49,13 +49,13 @@ def eq2_cost(tileset, tiles):
 
 
 def test_the_methods_are_the_documented_names():
-    assert SEQUENCE_METHODS == ("auto",) + tuple(FAST)
+    assert tuple(SPEC.methods) == ("auto",) + tuple(FAST)
 
 
 # ------------------------------------------------------------------------------------------ seeds
 # The stochastic methods and an option making their result depend on the seed.
 STOCHASTIC = {"local": {"restarts": 3, "max_starts": 1}, "ga": {"max_gen": 2}, "ga-plain": {"max_gen": 0},
-              "greedy": {"iterations": 3}, "exact": {}}
+              "greedy": {"iterations": 3}}
 
 
 @pytest.mark.parametrize("method", list(STOCHASTIC))
@@ -90,11 +90,13 @@ def test_every_method_refuses_a_bad_seed_naming_it(inst, function, seed):
         function(inst, seed=seed)
 
 
-@pytest.mark.parametrize("method", ["zigzag", "zigzag2", "spiral", "spiral2"])
-def test_the_deterministic_methods_ignore_the_seed(inst, method):
-    a = sequence_waypoints(inst, method=method, seed=0, **FAST[method])
-    b = sequence_waypoints(inst, method=method, seed=None, **FAST[method])
+@pytest.mark.parametrize("method", ["exact", "zigzag", "zigzag2", "spiral", "spiral2"])
+def test_the_deterministic_methods_take_no_seed(inst, method):
+    a = sequence_waypoints(inst, method=method, **FAST[method])
+    b = sequence_waypoints(inst, method=method, **FAST[method])
     assert a.order.tolist() == b.order.tolist()
+    with pytest.raises(ParameterError, match=f"seed applies to .* only, not to {method}"):
+        sequence_waypoints(inst, method=method, seed=0, **FAST[method])
 
 
 def test_ortools_accepts_every_kind_of_seed(inst):
@@ -120,7 +122,8 @@ def test_the_dispatcher_refuses_an_infinite_time_limit(inst):
 # --------------------------------------------------------------------------- method= and results
 @pytest.mark.parametrize("method", list(FAST))
 def test_every_named_method_gives_a_result_priced_by_eq2(fig13b, inst, method):
-    result = sequence_waypoints(inst, method=method, seed=1, **FAST[method])
+    seed = {"seed": 1} if SPEC.method(method).takes("seed") else {}
+    result = sequence_waypoints(inst, method=method, **seed, **FAST[method])
     assert isinstance(result, SequenceResult) and result.method == method
     assert result.tiles[0] == 1 and sorted(result.tiles) == sorted(fig13b.ids)
     assert result.cost == pytest.approx(eq2_cost(fig13b, result.tiles))

@@ -1,0 +1,107 @@
+"""The ``htetro-opt`` command line: one module per command, each built from the task specs.
+
+Every command takes a SCENARIO, a bundled name (``htetro-opt scenarios`` lists them) or a path to a
+scenario TOML file; ``sequence`` also takes a labelled tileset (a bundled name, ``htetro-opt
+scenarios`` lists them too, or a file) or a TSPLIB file. A command's ``--method`` choices, its options'
+flags, defaults and help, and the "this flag does not apply to that method" errors come from its task's
+spec (:mod:`htetro_opt._spec`); nothing here restates them. Errors print one ``error: …`` line and exit
+with status 2; Ctrl-C exits with 130 and SIGTERM with 143, one line each.
+
+This module imports only the standard library, so that the signal handlers are in place before
+anything heavy is imported; the commands import their solvers when they run.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import sys
+from typing import Sequence
+
+__all__ = ["main", "main_entry", "build_parser"]
+
+EXIT_ERROR = 2
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
+EXIT_TERMINATED = 143  # 128 + SIGTERM
+
+COMMANDS = ("scenarios", "plan", "simulate", "tile", "sequence", "study", "cover")
+"""The commands, each a module of this package with ``add_parser(sub)`` and ``run(args) -> dict``."""
+
+
+def build_parser():
+    """The parser of every command (their options from the task specs)."""
+    from importlib import import_module
+
+    from htetro_opt import __version__
+    from htetro_opt._argparse import Parser
+
+    parser = Parser(prog="htetro-opt", description="Path planning for the hTetro reconfigurable robot.",
+                    epilog="The robot model, the scenario and tileset formats and the JSON output are described in "
+                    "docs/model.md and docs/formats.md of the htetro-opt repository. Times are in seconds under the "
+                    "default timing. Long work shows progress on stderr when it is a terminal (--quiet: none).")
+    parser.add_argument("--version", action="version", version=f"htetro-opt {__version__}")
+    sub = parser.add_subparsers(dest="command", parser_class=Parser, metavar="COMMAND")
+    for command in COMMANDS:
+        import_module(f"htetro_opt.cli.{command}").add_parser(sub)
+    return parser
+
+
+class Terminated(BaseException):
+    """SIGTERM, turned into an exception so that ``finally`` blocks (temporary files) run."""
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; returns the exit status (0 success, 2 error, 130 interrupted, 143 terminated)."""
+    args = None
+    try:
+        from importlib import import_module
+
+        from htetro_opt._argparse import UsageError
+        from htetro_opt.cli._common import LateOutputError
+        from htetro_opt.errors import HtetroError
+
+        parser = build_parser()
+        try:
+            args = parser.parse_args(argv)
+            if args.command is None:
+                parser.print_help(sys.stderr)
+                return EXIT_ERROR
+            out = import_module(f"htetro_opt.cli.{args.command}").run(args)
+        except (UsageError, HtetroError) as err:
+            print("error: " + " ".join(str(err).split()), file=sys.stderr)
+            return EXIT_ERROR
+        except LateOutputError as late:  # the work is done: its result is not thrown away with the file
+            if getattr(args, "json", False):
+                print(json.dumps(late.out))
+            print("error: " + " ".join(str(late.error).split()), file=sys.stderr)
+            return EXIT_ERROR
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Terminated:
+        print("terminated", file=sys.stderr)
+        return EXIT_TERMINATED
+    except SystemExit as done:  # --help and --version
+        return int(done.code or 0)
+    if getattr(args, "json", False):
+        print(json.dumps(out))
+    return 0
+
+
+def _terminate(signum, frame) -> None:
+    raise Terminated()
+
+
+def main_entry() -> None:
+    """Console-script entry point: SIGTERM ends the command like Ctrl-C, one line and no traceback."""
+    signal.signal(signal.SIGTERM, _terminate)
+    try:
+        code = main()
+        sys.stdout.flush()
+    except BrokenPipeError:  # output piped into e.g. `head`, which closed it: not an error of ours
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        code = 1
+    except KeyboardInterrupt:  # a second Ctrl-C while the first was being handled
+        code = EXIT_INTERRUPTED
+    sys.exit(code)
