@@ -8,11 +8,13 @@ function of its own:
 - ``ortools`` (:func:`solve_ortools`): OR-Tools routing with guided local search, the paper's baseline;
 - ``ils`` (:func:`solve_ils`): the compiled (numba), seeded iterated local search — 2-opt and Or-opt
   with neighbour lists and don't-look bits, local double-bridge kicks — ``auto``'s engine beyond the
-  exact range;
-- ``local`` (:func:`solve_local`): nearest neighbour, 2-opt and Or-opt, optionally iterated (pure numpy);
+  exact range. Its local search is the package's one 2-opt/Or-opt local search: ``local``, the
+  memetic GA and :func:`improve` (with :func:`two_opt`, :func:`or_opt`, :func:`improve_batch`, for a
+  plain cost matrix) run it too;
+- ``local`` (:func:`solve_local`): nearest neighbour, then that local search to a local optimum of the
+  whole 2-opt/Or-opt neighbourhood, optionally iterated with :func:`double_bridge` kicks;
   :func:`nearest_neighbour_paths` is the one nearest-neighbour construction (the exact solver's
-  hint and the greedy baseline use it too), :func:`improve` / :func:`improve_batch` the one
-  2-opt/Or-opt local search (the memetic GA uses it too);
+  hint and the greedy baseline use it too);
 - ``ga``, ``ga-plain`` (:func:`solve_ga`): the paper's GA on DEAP, with or without a memetic step;
 - ``zigzag``, ``zigzag2``, ``spiral``, ``spiral2``, ``greedy``: the paper's baselines;
 - ``fast-tsp`` (:func:`solve_fast_tsp`) and ``lkh`` (:func:`solve_lkh`): outside solvers, optional

@@ -28,7 +28,10 @@ Stützle 2003):
   replaces, and every Or-opt move of a segment of 1–3 nodes beginning or ending at ``a`` to an edge
   next to one of its ends' neighbours, as it is or reversed; the first improving move is applied.
   Every move is a sequence of 2-opt moves (an Or-opt is two or three), each reversing the shorter
-  side of the tour array, and logged, so that a rejected kick is undone exactly.
+  side of the tour array, and logged, so that a rejected kick is undone exactly. A *full* pass
+  (:meth:`LocalCore.descend`, not the ILS) takes every other node as a candidate and prunes
+  nothing, so that one from every node that finds no move proves a local optimum of the whole
+  neighbourhood.
 - **Kicks**: a double bridge ``A B C D → A C B D`` whose three segments are 1–:data:`ILS_KICK_SPAN`
   nodes long (a *local* double bridge: it changes the tour near one random node), the local search
   restarted from the 8 nodes it touched, the result kept if it is no costlier, undone otherwise.
@@ -38,8 +41,10 @@ Stützle 2003):
   says so (``info["timed_out"]``) and is no longer reproducible.
 
 The kernel is compiled by numba (≥ 0.59, a core dependency, so that ``auto`` gives the same order on
-every install). :class:`LocalCore` runs the same local search (no kicks) on given orders: the
-memetic GA's local step. Should numba be missing,
+every install). :class:`LocalCore` runs the same local search on given orders: it is the package's
+one 2-opt / Or-opt local search, the memetic GA's local step (:meth:`LocalCore.improve`) and, with
+the full passes (:meth:`LocalCore.descend`), the ``local`` method's and
+:func:`~htetro_opt.solvers.sequencing.improve`'s. Should numba be missing,
 ``ils`` runs the pure-numpy ``local`` method with restarts under the same time cap instead, and says
 so in ``info["engine"]``: its results are worse (benchmarks/README.md) and depend on the clock.
 """
@@ -63,6 +68,9 @@ ILS_NEIGHBOURS = 8
 
 ILS_KICK_SPAN = 100
 """Longest segment of a kick's double bridge (each of its three segments has 1…this many nodes)."""
+
+_UNLIMITED = 1 << 62
+"""A move budget that never runs out."""
 
 try:  # pragma: no cover - depends on the environment
     import numba
@@ -162,6 +170,16 @@ def _log(log, count, a, b, c, d):
 @_jit
 def _or_move(tour, pos, log, count, p, s1, s2, nx, x, y, forward):
     """Move the segment s1…s2 (between p and nx) between x and y, reversed or not, by 2-opt moves."""
+    if y == p and x == nx:  # a tour of the segment, p and nx only: the segment reversed in place
+        _two_opt(tour, pos, p, s1, s2, nx)
+        return _log(log, count, p, s1, s2, nx)
+    if y == p:  # the edge just before p (only the full search tries it): reverse p…s2, then s2…s1 back
+        _two_opt(tour, pos, x, p, s2, nx)
+        count = _log(log, count, x, p, s2, nx)
+        if forward:
+            _two_opt(tour, pos, x, s2, s1, p)
+            count = _log(log, count, x, s2, s1, p)
+        return count
     _two_opt(tour, pos, p, s1, x, y)
     count = _log(log, count, p, s1, x, y)
     _two_opt(tour, pos, p, x, nx, s2)
@@ -206,19 +224,30 @@ if HAVE_NUMBA:
 
 
 @_jit
-def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count, eps):
-    """Improve the tour from the queued nodes until the queue is empty; (gain, moves logged)."""
+def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count, eps, opt2, lengths, full,
+                  budget):
+    """Improve the tour from the queued nodes until the queue is empty or ``budget`` moves are made:
+    (gain, head, moves logged, moves made).
+
+    ``opt2``: try 2-opt moves; ``lengths``: the Or-opt segment lengths, ascending (empty: no Or-opt).
+    Restricted (``full`` False, the ILS): a node's candidates are its neighbour list ``nbr`` (legs
+    ``nc``, cheapest first), and the scan of a list stops at the first neighbour whose leg leaves no
+    gain. ``full``: every other node is a candidate and nothing is pruned, so that a pass from every
+    node that makes no move proves the tour a local optimum of the whole 2-opt / Or-opt neighbourhood.
+    """
     n = tour.shape[0]
-    k = nbr.shape[1]
+    k = n - 1 if full else nbr.shape[1]
     gain_total = 0.0
-    while size > 0:
+    moves = 0
+    while size > 0 and moves < budget:
         a = queue[head]
         head = (head + 1) % n
         size -= 1
         queued[a] = False
         improved = False
-        # 2-opt: a new edge (a, c), c a neighbour, in both directions of the tour
-        for direction in range(2):
+        # 2-opt: a new edge (a, c), c a candidate, in both directions of the tour (full: one is
+        # enough, every pair of edges being (a, succ a) and (c, succ c) for some a)
+        for direction in range((1 if full else 2) if opt2 else 0):
             if improved:
                 break
             if direction == 0:
@@ -227,10 +256,14 @@ def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count,
                 b = tour[(pos[a] - 1) % n]
             d_ab = _d(cm, a, b)
             for t in range(k):
-                c = nbr[a, t]
-                g1 = d_ab - nc[a, t]
-                if g1 <= eps:
-                    break
+                if full:
+                    c = t if t < a else t + 1
+                    g1 = d_ab - _d(cm, a, c)
+                else:
+                    c = nbr[a, t]
+                    g1 = d_ab - nc[a, t]
+                    if g1 <= eps:  # the list is sorted: no later neighbour gives a cheaper first edge
+                        break
                 if direction == 0:
                     d = tour[(pos[c] + 1) % n]
                 else:
@@ -246,19 +279,23 @@ def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count,
                         _two_opt(tour, pos, b, a, d, c)
                         count = _log(log, count, b, a, d, c)
                     gain_total += gain
+                    moves += 1
                     size = _push(queue, queued, head, size, a)
                     size = _push(queue, queued, head, size, b)
                     size = _push(queue, queued, head, size, c)
                     size = _push(queue, queued, head, size, d)
                     improved = True
                     break
-        if improved or n < 8:
+        if improved:
             continue
-        # Or-opt: a segment of 1-3 nodes with a at one end, next to a neighbour of a
-        for length in range(1, 4):
+        # Or-opt: a segment with a at one end, next to a candidate (full: into any edge)
+        for li in range(lengths.shape[0]):
             if improved:
                 break
-            for direction in range(2):
+            length = lengths[li]
+            if length > n - 2:  # p and nx would not both lie outside the segment
+                break
+            for direction in range(1 if full else 2):  # full: every segment begins at some a
                 if improved:
                     break
                 # the segment s1 … s2 in tour order, a = s1 (direction 0) or a = s2 (direction 1)
@@ -271,29 +308,38 @@ def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count,
                 p = tour[(i - 1) % n]
                 nx = tour[(i + length) % n]
                 removal = _d(cm, p, s1) + _d(cm, s2, nx) - _d(cm, p, nx)
-                if removal <= eps:
+                if removal <= eps and not full:
                     continue
                 for t in range(k):
-                    c = nbr[a, t]
-                    if removal - nc[a, t] <= eps:
-                        break
+                    if full:
+                        c = t if t < a else t + 1
+                    else:
+                        c = nbr[a, t]
+                        if removal - nc[a, t] <= eps:
+                            break
                     # c must lie outside the segment
                     off = (pos[c] - i) % n
                     if off < length:
                         continue
-                    # the two edges at c: (c, succ c) and (pred c, c)
-                    for side in range(2):
+                    # the two edges at c: (c, succ c) and (pred c, c); the full search, whose c are
+                    # all the nodes, needs only the first
+                    for side in range(1 if full else 2):
                         if side == 0:
                             x, y = c, tour[(pos[c] + 1) % n]
                         else:
                             x, y = tour[(pos[c] - 1) % n], c
-                        if x == s2 or y == s1 or y == p:  # (s2, nx), (p, s1), or no move at all
+                        if x == s2 or y == s1:  # (s2, nx) or (p, s1): no move at all
+                            continue
+                        if y == p and not full:  # the edge before p: only the full search tries it
+                            # (so the ILS makes the moves it always made)
                             continue
                         if (pos[x] - i) % n < length or (pos[y] - i) % n < length:
                             continue
+                        # the legs to the segment's ends are read from their rows (the costs are
+                        # symmetric), which stay in the cache while c runs over the candidates
                         base = removal + _d(cm, x, y)
-                        fwd = base - _d(cm, x, s1) - _d(cm, s2, y)
-                        rev = base - _d(cm, x, s2) - _d(cm, s1, y)
+                        fwd = base - _d(cm, s1, x) - _d(cm, s2, y)
+                        rev = base - _d(cm, s2, x) - _d(cm, s1, y)
                         if fwd >= rev and fwd > eps:
                             count = _or_move(tour, pos, log, count, p, s1, s2, nx, x, y, True)
                             gain_total += fwd
@@ -303,12 +349,13 @@ def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count,
                             gain_total += rev
                             improved = True
                         if improved:
+                            moves += 1
                             for node in (a, p, nx, s1, s2, x, y):
                                 size = _push(queue, queued, head, size, node)
                             break
                     if improved:
                         break
-    return gain_total, head, count
+    return gain_total, head, count, moves
 
 
 @_jit
@@ -318,6 +365,36 @@ def _tour_cost(cm, tour):
     for i in range(n):
         total += _d(cm, tour[i], tour[(i + 1) % n])
     return total
+
+
+@_jit
+def _neighbour_costs(cm, nbr):
+    """Each node's legs to its neighbours, the search's most frequent look-ups, priced once (eq. 2 has
+    four square roots a leg)."""
+    nc = np.empty(nbr.shape)
+    for a in range(nbr.shape[0]):
+        for t in range(nbr.shape[1]):
+            nc[a, t] = _d(cm, a, nbr[a, t])
+    return nc
+
+
+@_jit
+def _descend(cm, nbr, nc, tour, opt2, lengths, full, eps, budget):
+    """One pass of the local search (:func:`_local_search`) from every node of the tour, in place, until
+    no queued node has an improving move or ``budget`` moves are made: the moves made."""
+    n = tour.shape[0]
+    pos = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        pos[tour[i]] = i
+    queue = np.empty(n, dtype=np.int64)
+    queued = np.zeros(n, dtype=np.bool_)
+    size = 0
+    for i in range(n):
+        size = _push(queue, queued, 0, size, tour[i])
+    log = np.empty((0, 4), dtype=np.int64)  # nothing is undone: no move is logged
+    _, _, _, moves = _local_search(cm, nbr, nc, tour, pos, queue, queued, 0, size, log, 0, eps, opt2, lengths,
+                                   full, budget)
+    return moves
 
 
 @_jit
@@ -333,17 +410,14 @@ def _ils(cm, nbr, tour, kicks, span, seed, eps):
     log = np.empty((4 * n + 64, 4), dtype=np.int64)
     state = np.empty(1, dtype=np.uint64)
     state[0] = np.uint64(seed)
-    # each node's legs to its neighbours, the search's most frequent lookups, priced once (eq. 2 has
-    # four square roots a leg)
-    nc = np.empty(nbr.shape)
-    for a in range(nbr.shape[0]):
-        for t in range(nbr.shape[1]):
-            nc[a, t] = _d(cm, a, nbr[a, t])
+    nc = _neighbour_costs(cm, nbr)
+    lengths = np.arange(1, 4)
     head = 0
     size = 0
     for i in range(n):
         size = _push(queue, queued, head, size, tour[i])
-    _, head, _ = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, 0, eps)
+    _, head, _, _ = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, 0, eps, True, lengths,
+                                  False, _UNLIMITED)
     size = 0
     kept = 0
     done = 0
@@ -373,7 +447,8 @@ def _ils(cm, nbr, tour, kicks, span, seed, eps):
         count = _log(log, count, c2, b2, b1, d1)
         for node in (a1, b1, b2, c1, c2, d1):
             size = _push(queue, queued, head, size, node)
-        gain, head, count = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count, eps)
+        gain, head, count, _ = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count, eps,
+                                             True, lengths, False, _UNLIMITED)
         size = 0
         if delta - gain <= eps and count <= log.shape[0]:
             if delta - gain < -eps:
@@ -515,6 +590,23 @@ def _decode(tour: np.ndarray, dummy: int | None, instance: SequencingInstance) -
     return order.copy()
 
 
+def _as_directed(order: np.ndarray, before: np.ndarray, instance: SequencingInstance) -> np.ndarray:
+    """``order``, or the same path (tour) run the other way where the instance allows it, whichever
+    moved the waypoints of ``before`` less: a move may reverse the complement of a segment, so the
+    search turns the whole tour round at times, which a free path or a tour does not notice but a
+    caller improving an order would."""
+    if instance.closed:
+        other = np.concatenate([order[:1], order[:0:-1]])
+    elif instance.start is None and instance.end is None:
+        other = order[::-1].copy()
+    else:
+        return order
+    at = np.empty(len(before), dtype=np.int64)
+    at[before] = np.arange(len(before))
+    shift = [int(np.abs(at[o] - np.arange(len(o))).sum()) for o in (order, other)]
+    return other if shift[1] < shift[0] else order
+
+
 def _greedy_tour(D: np.ndarray) -> np.ndarray:
     """The nearest-neighbour tour from node 0 (the package's one construction)."""
     from htetro_opt.solvers.sequencing._local import nearest_neighbour_paths
@@ -629,8 +721,26 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
 
 class LocalCore:
     """The compiled local search (2-opt + Or-opt, neighbour lists, don't-look bits) of ``ils`` on one
-    instance, prepared once (cost model and neighbour lists) for many orders: the memetic GA's local
-    step.
+    instance, prepared once (cost model and neighbour lists) for many orders: the package's one
+    2-opt / Or-opt local search.
+
+    :meth:`improve` is the memetic GA's local step (the neighbour-list search, optionally with
+    kicks); :meth:`descend` adds the full passes that make its result a local optimum of the whole
+    neighbourhood: the ``local`` method and :func:`~htetro_opt.solvers.sequencing.improve` (and its
+    :func:`~htetro_opt.solvers.sequencing.two_opt`, :func:`~htetro_opt.solvers.sequencing.or_opt`
+    and :func:`~htetro_opt.solvers.sequencing.improve_batch`) run it.
+
+    Parameters
+    ----------
+    instance : SequencingInstance
+        Symmetric costs (a matrix or implicit), an open path or a closed tour.
+    neighbours : int
+        Size of each node's neighbour list.
+
+    Raises
+    ------
+    ParameterError
+        On an asymmetric instance or ``neighbours < 1``.
 
     Examples
     --------
@@ -639,31 +749,88 @@ class LocalCore:
     >>> core = LocalCore(SequencingInstance.from_matrix(np.abs(np.subtract.outer(x, x)), start=0))
     >>> core.improve(np.arange(10)).tolist()
     [0, 2, 4, 5, 3, 1, 7, 6, 9, 8]
+
+    Below 8 nodes only :meth:`descend` moves:
+
+    >>> small = LocalCore(SequencingInstance.from_matrix(np.abs(np.subtract.outer(x[:6], x[:6])), start=0))
+    >>> small.improve(np.arange(6)).tolist(), small.descend(np.arange(6)).tolist()
+    ([0, 1, 2, 3, 4, 5], [0, 2, 4, 5, 3, 1])
     """
 
     def __init__(self, instance: SequencingInstance, *, neighbours: int = ILS_NEIGHBOURS) -> None:
         self.instance = check_instance(instance)
         if not instance.symmetric:
             raise ParameterError("the compiled local search assumes a symmetric cost matrix")
+        k = check_int(neighbours, "neighbours", minimum=1)
         self.cm, self.m, self.dummy, top = _cost_model(instance)
         self.eps = 1e-9 * max(1.0, top)
-        self.nbr = None
-        if self.m >= 8 and HAVE_NUMBA:
-            k = check_int(neighbours, "neighbours", minimum=1)
+        self.nbr = self.nc = None
+        if self.m >= 4:  # below, every tour costs the same: no move to make
             self.nbr = (_implicit_neighbour_lists(self.cm, self.dummy, k) if instance.implicit
                         else _neighbour_lists(self.cm, k))
 
     def improve(self, order, *, kicks: int = 0, seed: int = 0) -> np.ndarray:
-        """``order`` (a valid order of the instance) improved to a local optimum, after ``kicks``
-        local double-bridge kicks when positive (seeded by ``seed``); unchanged below 8 nodes or
-        without numba."""
+        """``order`` (a valid order of the instance) improved by the neighbour-list search of ``ils``,
+        after ``kicks`` local double-bridge kicks when positive (seeded by ``seed``); unchanged below
+        8 nodes (where ``ils`` enumerates instead; the memetic GA's results on tiny instances stay
+        those it has always given)."""
         order = self.instance.check_order(order)
-        if self.nbr is None:
+        if self.m < 8 or not HAVE_NUMBA:
             return order
         tour = order if self.dummy is None else np.append(order, self.dummy)
         tour = np.ascontiguousarray(tour, dtype=np.int64)
         _ils(self.cm, self.nbr, tour, int(kicks), ILS_KICK_SPAN, np.uint64(seed % 2**64), self.eps)
         return _decode(tour, self.dummy, self.instance)
+
+    def descend(self, order, *, two_opt: bool = True, lengths=(1, 2, 3), certify: bool = True,
+                max_moves: int | None = None, deadline: float = math.inf) -> np.ndarray:
+        """``order`` improved to a local optimum of 2-opt and Or-opt (no kicks), at any size.
+
+        The neighbour-list search of ``ils`` from every node, then (``certify``) a full pass from
+        every node, every other node a candidate and no move pruned; while the full pass still
+        moves, both again. The result is then a local optimum of the whole neighbourhood: no 2-opt
+        move (with ``two_opt``) and no move of a segment of one of the ``lengths`` to another edge,
+        as it is or reversed, lowers the tour's cost by more than ``2 · eps``.
+
+        Parameters
+        ----------
+        order : array_like of int
+            A valid order of the instance.
+        two_opt : bool
+            Try 2-opt moves.
+        lengths : sequence of int
+            Or-opt's segment lengths, positive (empty: no Or-opt).
+        certify : bool
+            Run the full passes (False: the neighbour-list search only, e.g. to repair a kick).
+        max_moves : int, optional
+            Make at most this many improving moves (None: to the local optimum).
+        deadline : float
+            A ``time.perf_counter()`` instant after which no pass starts (a pass is not interrupted).
+
+        Returns
+        -------
+        ndarray of int64
+            The order, never costlier than ``order``.
+        """
+        order = self.instance.check_order(order)
+        budget = _UNLIMITED if max_moves is None else int(max_moves)
+        if self.nbr is None or budget <= 0 or time.perf_counter() >= deadline:
+            return order
+        if self.nc is None:
+            self.nc = _neighbour_costs(self.cm, self.nbr)
+        tour = order if self.dummy is None else np.append(order, self.dummy)
+        tour = np.ascontiguousarray(tour, dtype=np.int64)
+        lengths = np.array(sorted({int(L) for L in lengths}), dtype=np.int64)
+        two_opt = bool(two_opt)
+        while True:
+            budget -= _descend(self.cm, self.nbr, self.nc, tour, two_opt, lengths, False, self.eps, budget)
+            if not certify or budget <= 0 or time.perf_counter() >= deadline:
+                break
+            made = _descend(self.cm, self.nbr, self.nc, tour, two_opt, lengths, True, self.eps, budget)
+            budget -= made
+            if made == 0 or budget <= 0 or time.perf_counter() >= deadline:
+                break
+        return _as_directed(_decode(tour, self.dummy, self.instance), order, self.instance)
 
 
 def _fallback(instance, rng, time_limit):

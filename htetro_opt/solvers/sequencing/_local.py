@@ -1,23 +1,4 @@
-"""Local search for the open-path waypoint TSP of Le et al. 2018: nearest neighbour, 2-opt, Or-opt, ILS.
-
-Moves are priced with numpy, never one by one: a round computes the gain of every candidate move as
-a matrix (rows: a position, columns: its partner positions), takes each row's best, and applies a
-greedy set of non-overlapping improving moves (largest gain first). Two kinds of rounds:
-
-- *restricted*: only moves creating an edge from a waypoint to one of its :data:`NEIGHBOURS`
-  cheapest waypoints, or touching an end of the path — O(n·k) per round;
-- *full*: every move, from the cost matrix gathered in path order ``C[order][:, order]`` — O(n²).
-
-A search runs restricted rounds until none improves, then one full round of each move to certify
-the result, and goes back to restricted rounds if the full one still improved. So the result is a
-true local optimum of the neighbourhood, and on 1000 random points nearest neighbour + 2-opt +
-Or-opt takes about 0.2–0.5 s here (most of it the two certifying O(n²) rounds).
-
-The path is **open**: it does not return to its first waypoint. Both ends are handled with a dummy
-waypoint that costs nothing to reach: the path is padded with it at the end (fixed start: the first
-waypoint never moves) or at both ends (free start). Reversing a suffix then changes one edge only,
-and with a free start so does reversing a prefix; moving a segment to either end is an ordinary
-insertion next to the dummy.
+"""Nearest neighbour and 2-opt / Or-opt for the open-path waypoint TSP of Le et al. 2018: the ``local`` method.
 
 - :func:`nearest_neighbour_paths` — the one nearest-neighbour construction, batched: many paths at
   once, each from its own first (and optionally forced second) waypoint, ties to the lowest index
@@ -25,15 +6,35 @@ insertion next to the dummy.
   on it too;
 - :func:`nearest_neighbour` — the greedy construction (from the fixed start, or the best of many
   starts);
-- :func:`two_opt` — reverse ``order[i..j]``;
-- :func:`or_opt` — move a segment of 1–3 waypoints elsewhere, optionally reversed;
-- :func:`improve` — 2-opt and Or-opt in turn until neither improves;
+- :func:`two_opt`, :func:`or_opt`, :func:`improve`, :func:`improve_batch` — the package's one
+  2-opt / Or-opt local search, the compiled one of ``ils``
+  (:meth:`~htetro_opt.solvers.sequencing._ils.LocalCore.descend`), on a plain cost matrix: they
+  check their arguments, hand the open path to it and return its local optimum;
 - :func:`double_bridge` — the classic kick of iterated local search;
 - :func:`solve_local` — the ``local`` method of :func:`~htetro_opt.solvers.sequencing.sequence_waypoints`:
-  nearest neighbour, then :func:`improve`, then optionally iterated local search.
+  nearest neighbour, then the local search, then optionally iterated local search.
+
+The search makes first-improvement moves from each waypoint's :data:`NEIGHBOURS` cheapest waypoints
+(neighbour lists and don't-look bits, as in ``ils``), then full passes in which every waypoint is a
+candidate and no move is pruned, until one makes no move: so the result is a true local optimum of
+the neighbourhood (no reversal of a sub-path, and no move of a segment of 1–3 waypoints elsewhere,
+as it is or reversed, makes the path cheaper). Each full pass costs O(n²) cost look-ups, in compiled
+code: on 1000 random points nearest neighbour and the search take about 0.2–0.3 s here (2 s on
+3000), most of it the two or three certifying passes; a restart of the iterated search, which
+certifies nothing, takes about 1 ms on 1000 points (15 ms with the earlier numpy search).
+
+The path is **open**: it does not return to its first waypoint. The compiled search works on closed
+tours, so the path is closed through a dummy waypoint: its legs cost nothing with a free start, and
+with a fixed start a penalty on its legs to every other waypoint pins the start next to it (the
+dummy-node reduction of :mod:`~htetro_opt.solvers.sequencing._ils`). Reversing a suffix then changes
+one edge of the path, and with a free start so does reversing a prefix; moving a segment to either
+end is an ordinary insertion next to the dummy.
 
 The gains assume a symmetric cost (eq. 2 is); an asymmetric matrix is refused. Improvements smaller
-than ``1e-9 × max |cost|`` are ignored, so rounding noise never cycles.
+than ``1e-9`` times the largest leg of the closed tour (the penalty included, and at least 1) are
+ignored, so rounding noise never cycles. The compiled search is imported when a search first runs,
+so that importing this module (as the exact solver and the greedy baseline do, for the
+construction) does not import numba.
 """
 
 from __future__ import annotations
@@ -47,7 +48,7 @@ import numpy as np
 from htetro_opt._progress import check_progress, report
 from htetro_opt._validation import as_rng, check_bool, check_int, check_real, check_time_limit
 from htetro_opt.errors import ParameterError
-from htetro_opt.problems.waypoint_sequencing import check_instance
+from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance
 from htetro_opt.solvers.sequencing._budgets import default_time_limit
 
 __all__ = [
@@ -64,10 +65,8 @@ __all__ = [
 ]
 
 NEIGHBOURS = 10
-"""Size of each waypoint's candidate list in the restricted rounds."""
-
-_BATCH_ELEMENTS = 2_000_000
-"""The batched local search of :func:`improve_batch` gathers at most this many costs at a time."""
+"""Size of each waypoint's neighbour list in the local search's first phase (``ils`` uses
+:data:`~htetro_opt.solvers.sequencing.ILS_NEIGHBOURS`)."""
 
 
 # --------------------------------------------------------------------------------------- checks
@@ -102,9 +101,8 @@ def _check_order(order, n: int) -> np.ndarray:
     return p
 
 
-def _check_rounds(max_rounds) -> float:
-    rounds = check_int(max_rounds, "max_rounds", minimum=0, allow_none=True)
-    return math.inf if rounds is None else rounds
+def _check_rounds(max_rounds) -> int | None:
+    return check_int(max_rounds, "max_rounds", minimum=0, allow_none=True)
 
 
 def _check_lengths(segment_lengths) -> tuple[int, ...]:
@@ -121,251 +119,22 @@ def _tolerance(C: np.ndarray) -> float:
     return 1e-9 * float(np.abs(C).max())
 
 
-# ------------------------------------------------------------------------------ padded paths
-def _padded_cost(C: np.ndarray) -> np.ndarray:
-    """C with one more row and column of zeros: the dummy waypoint ``n`` at the open end(s)."""
-    n = len(C)
-    D = np.zeros((n + 1, n + 1))
-    D[:n, :n] = C
-    return D
+# ------------------------------------------------------------------------------- the local search
+def _core(C: np.ndarray, first: int | None, neighbours: int = NEIGHBOURS):
+    """The compiled local search prepared on the open path of ``C`` from ``first`` (None: a free start)."""
+    from htetro_opt.solvers.sequencing._ils import LocalCore  # imports numba: only when a search runs
+
+    return LocalCore(SequencingInstance(C, None, first), neighbours=neighbours)
 
 
-def _pad(order: np.ndarray, n: int, fixed_start: bool) -> np.ndarray:
-    tail = np.array([n], dtype=np.int64)
-    return np.concatenate([order, tail] if fixed_start else [tail, order, tail])
-
-
-def _unpad(q: np.ndarray, fixed_start: bool) -> np.ndarray:
-    return q[:-1].copy() if fixed_start else q[1:-1].copy()
-
-
-def _neighbours(C: np.ndarray, k: int) -> np.ndarray:
-    """The k cheapest other waypoints of every waypoint, plus a row for the dummy (any k waypoints:
-    the end moves are priced separately)."""
-    n = len(C)
-    k = min(k, n - 1)
-    if k <= 0:
-        return np.zeros((n + 1, 0), dtype=np.int64)
-    masked = C + np.diag(np.full(n, np.inf))
-    table = np.argpartition(masked, k - 1, axis=1)[:, :k] if k < n - 1 else np.argsort(masked, axis=1)[:, :k]
-    return np.vstack([table, np.arange(k)[None, :]]).astype(np.int64)
-
-
-def _gather(D: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """``D[q][:, q]``: the costs in path order (two takes beat ``np.ix_``)."""
-    return D.take(q, axis=0).take(q, axis=1)
-
-
-def _greedy_disjoint(gain: np.ndarray, lo: np.ndarray, hi: np.ndarray, m: int) -> list[int]:
-    """Indices of a greedy (largest gain first) set of moves whose edge spans [lo, hi] are disjoint."""
-    used = np.zeros(m, dtype=bool)
-    chosen = []
-    for k in np.argsort(-gain, kind="stable").tolist():
-        a, b = lo[k], hi[k]
-        if not used[a:b + 1].any():
-            used[a:b + 1] = True
-            chosen.append(k)
-    return chosen
-
-
-def _row_best(gain: np.ndarray, *columns: np.ndarray):
-    """Per row, the largest gain and the matching entries of ``columns`` (same shape as ``gain``)."""
-    rows = np.arange(len(gain))
-    best = gain.argmax(1)
-    return (gain[rows, best],) + tuple(c[rows, best] for c in columns)
-
-
-class _Search:
-    """2-opt and Or-opt rounds on padded paths of one cost matrix.
-
-    A round is either *restricted* — only moves that create an edge to one of a waypoint's
-    ``neighbours`` cheapest waypoints, or touch an end of the path: O(n·k) — or *full*: every move,
-    O(n²). The search runs restricted rounds to their local optimum, then full rounds to certify it
-    (and resumes if a full round still finds moves), so the result is a true local optimum.
-    """
-
-    def __init__(self, C: np.ndarray, fixed_start: bool, lengths=(1, 2, 3), neighbours: int = NEIGHBOURS,
-                 max_rounds: float = math.inf, deadline: float = math.inf) -> None:
-        self.n = len(C)
-        self.D = _padded_cost(C)
-        self._flat = self.D.ravel()
-        self.tol = _tolerance(C)
-        self.fixed = fixed_start
-        self.lengths = lengths
-        self.nbr = _neighbours(C, neighbours)
-        self.budget = max_rounds
-        self.deadline = deadline
-
-    # -- helpers
-    def _cost(self, a, b) -> np.ndarray:
-        """``D[a, b]`` (broadcast) by a flat take, faster than 2-D fancy indexing."""
-        return np.take(self._flat, a * len(self.D) + b)
-
-    def _positions(self, q: np.ndarray) -> np.ndarray:
-        pos = np.zeros(len(self.D), dtype=np.int64)
-        pos[q] = np.arange(len(q))  # the dummy's entry is never read: no neighbour list holds it
-        return pos
-
-    def _ends(self, rows: int, m: int) -> list[np.ndarray]:
-        """Columns of partner edges at the ends: the last edge (to the dummy), and with a free
-        start the first one (from the dummy)."""
-        cols = [np.full((rows, 1), m - 2, dtype=np.int64)]
-        if not self.fixed:
-            cols.append(np.zeros((rows, 1), dtype=np.int64))
-        return cols
-
-    # -- 2-opt
-    def two_opt_moves(self, q: np.ndarray, full: bool):
-        """Best 2-opt partner edge of every edge: (gain, lo, hi) with edges lo + 2 ≤ hi."""
-        D, m = self.D, len(q)
-        e1 = np.arange(m - 1)
-        if full:
-            Q = _gather(D, q)
-            E = np.diagonal(Q, 1)
-            G = E[:, None] - Q[:-1, :-1]
-            G += E
-            G -= Q[1:, 1:]
-            G[e1, e1] = 0.0
-            G[e1[:-1], e1[1:]] = 0.0
-            G[e1[1:], e1[:-1]] = 0.0
-            e2 = np.broadcast_to(e1, G.shape)
-        else:
-            pos = self._positions(q)
-            a, b = q[:-1], q[1:]
-            E = self._cost(a, b)
-            e2 = np.hstack([pos[self.nbr[a]], pos[self.nbr[b]] - 1, *self._ends(m - 1, m)])
-            valid = (e2 >= 0) & (e2 <= m - 2) & (np.abs(e2 - e1[:, None]) >= 2)
-            e2 = np.where(valid, e2, 0)
-            G = E[:, None] + E[e2]
-            G -= self._cost(a[:, None], q[e2])
-            G -= self._cost(b[:, None], q[e2 + 1])
-            G[~valid] = 0.0
-        gain, partner = _row_best(G, e2)
-        return gain, np.minimum(e1, partner), np.maximum(e1, partner)
-
-    def two_opt_round(self, q: np.ndarray, full: bool) -> float:
-        """One round (in place); the total gain applied."""
-        if len(q) < 4:
-            return 0.0
-        gain, lo, hi = self.two_opt_moves(q, full)
-        keep = gain > self.tol
-        if not keep.any():
-            return 0.0
-        lo, hi, gain = lo[keep], hi[keep], gain[keep]
-        _, first = np.unique(lo * len(q) + hi, return_index=True)  # (e1, e2) and (e2, e1) are one move
-        lo, hi, gain = lo[first], hi[first], gain[first]
-        total = 0.0
-        for c in _greedy_disjoint(gain, lo, hi, len(q)):
-            a, b = lo[c] + 1, hi[c] + 1
-            q[a:b] = q[a:b][::-1].copy()
-            total += gain[c]
-        return total
-
-    # -- Or-opt
-    def or_opt_moves(self, q: np.ndarray, L: int, full: bool, Q=None):
-        """Best move of every segment q[i:i+L]: (i, gain, k, reversed), k the edge it goes into."""
-        m = len(q)
-        S = m - 1 - L  # segments start at i = 1..m-1-L
-        if S <= 0:
-            return None
-        i = np.arange(1, m - L)
-        prev, s0, se, nxt = q[i - 1], q[i], q[i + L - 1], q[i + L]
-        removal = self._cost(prev, s0) + self._cost(se, nxt) - self._cost(prev, nxt)
-        if full:
-            E = np.diagonal(Q, 1)
-            k = np.broadcast_to(np.arange(m - 1), (S, m - 1))
-            forward = Q[1:m - L, :m - 1] + Q[L:m - 1, 1:m]
-            forward -= E
-            if L > 1:
-                reverse = Q[L:m - 1, :m - 1] + Q[1:m - L, 1:m]
-                reverse -= E
-            rows = np.arange(S)
-            invalid = np.zeros((S, m - 1), dtype=bool)
-            for t in range(L + 1):  # edges i−1 … i+L−1 touch the segment: row r = i − 1, edge r + t
-                ok = rows + t < m - 1
-                invalid[rows[ok], rows[ok] + t] = True
-        else:
-            pos = self._positions(q)
-            k = np.hstack([pos[self.nbr[s0]], pos[self.nbr[s0]] - 1, pos[self.nbr[se]],
-                           pos[self.nbr[se]] - 1, *self._ends(S, m)])
-            valid = (k >= 0) & (k <= m - 2) & ((k < i[:, None] - 1) | (k > i[:, None] + L - 1))
-            k = np.where(valid, k, 0)
-            qa, qb = q[k], q[k + 1]
-            E = self._cost(qa, qb)
-            forward = self._cost(qa, s0[:, None]) + self._cost(se[:, None], qb) - E
-            reverse = self._cost(qa, se[:, None]) + self._cost(s0[:, None], qb) - E
-            invalid = ~valid
-        if L > 1:
-            flipped = reverse < forward
-            np.minimum(forward, reverse, out=forward)
-        else:
-            flipped = np.zeros(forward.shape, dtype=bool)
-        forward[invalid] = np.inf
-        gain, k, flipped = _row_best(removal[:, None] - forward, k, flipped)
-        return i, gain, k, flipped
-
-    def or_opt_round(self, q: np.ndarray, full: bool) -> float:
-        """One round (in place); the total gain applied."""
-        Q = _gather(self.D, q) if full else None
-        parts = [(L, g) for L in self.lengths if (g := self.or_opt_moves(q, L, full, Q)) is not None]
-        if not parts:
-            return 0.0
-        i, gain, k, rev = (np.concatenate([g[c] for _, g in parts]) for c in range(4))
-        L = np.concatenate([np.full(len(g[0]), L) for L, g in parts])
-        keep = gain > self.tol
-        if not keep.any():
-            return 0.0
-        i, gain, k, rev, L = i[keep], gain[keep], k[keep], rev[keep], L[keep]
-        lo, hi = np.minimum(i - 1, k), np.maximum(i + L - 1, k)
-        total = 0.0
-        for c in _greedy_disjoint(gain, lo, hi, len(q)):
-            _move_segment(q, int(i[c]), int(L[c]), int(k[c]), bool(rev[c]))
-            total += gain[c]
-        return total
-
-    # -- drivers
-    def _live(self) -> bool:
-        return self.budget > 0 and time.perf_counter() < self.deadline
-
-    def _round(self, round_fn, q: np.ndarray, full: bool) -> bool:
-        if not self._live():
-            return False
-        self.budget -= 1
-        return round_fn(q, full) > 0.0
-
-    def _rounds(self, round_fn, q: np.ndarray, full: bool) -> bool:
-        """Rounds until none improves or the budget/deadline runs out; True if any did."""
-        improved = False
-        while self._round(round_fn, q, full):
-            improved = True
-        return improved
-
-    def descend(self, q: np.ndarray, round_fns, certify: bool = True) -> np.ndarray:
-        """Restricted rounds of each move in turn until none improves, then (``certify``) one full
-        round of each; back to restricted rounds if a full one still improved."""
-        while True:
-            improved = True
-            while improved:
-                improved = self._each(round_fns, q, self._rounds, full=False)
-            if not certify or not self._each(round_fns, q, self._round, full=True):
-                return q
-
-    @staticmethod
-    def _each(round_fns, q, runner, *, full: bool) -> bool:
-        """Run ``runner`` for every move in turn (no short cut); True if any improved."""
-        improved = False
-        for fn in round_fns:
-            improved |= runner(fn, q, full)
-        return improved
-
-
-def _move_segment(q: np.ndarray, i: int, L: int, k: int, rev: bool) -> None:
-    """Move q[i:i+L] (reversed if ``rev``) between q[k] and q[k+1], in place."""
-    seg = q[i:i + L][::-1] if rev else q[i:i + L]
-    if k < i:
-        q[k + 1:i + L] = np.concatenate([seg, q[k + 1:i]])
-    else:
-        q[i:k + 1] = np.concatenate([q[i + L:k + 1], seg])
+def _search(C: np.ndarray, p: np.ndarray, fixed_start: bool, *, two_opt: bool = True, lengths=(1, 2, 3),
+            max_rounds: int | None = None) -> np.ndarray:
+    """The checked order ``p`` improved by :meth:`LocalCore.descend` (paths of one or two waypoints
+    have no move: unchanged)."""
+    if len(p) < 3:
+        return p.copy()
+    core = _core(C, int(p[0]) if fixed_start else None)
+    return core.descend(p, two_opt=two_opt, lengths=lengths, max_moves=max_rounds)
 
 
 # ----------------------------------------------------------------------------- public API
@@ -522,10 +291,9 @@ def nearest_neighbour(cost, *, start: int | None = None, max_starts: int = 32) -
 def two_opt(cost, order, *, fixed_start: bool = True, max_rounds: int | None = None) -> np.ndarray:
     """Open-path 2-opt: reverse sub-paths ``order[i..j]`` while that shortens the path.
 
-    Each round prices the candidate reversals at once and applies a greedy set of non-overlapping
-    improving ones (largest gain first); see the module docstring for the restricted and full
-    rounds. Reversing a suffix changes one edge only; with ``fixed_start=False`` reversing a prefix
-    too.
+    The compiled local search (module docstring) with 2-opt moves only: first-improvement moves
+    from the neighbour lists, then full passes over every reversal until one finds none. Reversing
+    a suffix changes one edge only; with ``fixed_start=False`` reversing a prefix too.
 
     Parameters
     ----------
@@ -536,7 +304,8 @@ def two_opt(cost, order, *, fixed_start: bool = True, max_rounds: int | None = N
     fixed_start : bool
         Keep ``order[0]`` first (True) or let any waypoint begin the path.
     max_rounds : int, optional
-        Stop after this many rounds (None: at the 2-opt local optimum).
+        Make at most this many improving moves (None: to the 2-opt local optimum). The name is the
+        earlier search's, each of whose rounds applied a set of moves; a round is now one move.
 
     Returns
     -------
@@ -562,16 +331,15 @@ def two_opt(cost, order, *, fixed_start: bool = True, max_rounds: int | None = N
     C = _check_cost(cost)
     p = _check_order(order, len(C))
     fixed_start = check_bool(fixed_start, "fixed_start")
-    search = _Search(C, fixed_start, max_rounds=_check_rounds(max_rounds))
-    return _unpad(search.descend(_pad(p, len(C), fixed_start), [search.two_opt_round]), fixed_start)
+    return _search(C, p, fixed_start, lengths=(), max_rounds=_check_rounds(max_rounds))
 
 
 def or_opt(cost, order, *, fixed_start: bool = True, segment_lengths=(1, 2, 3),
            max_rounds: int | None = None) -> np.ndarray:
     """Or-opt: move a segment of consecutive waypoints, as is or reversed, to a cheaper place.
 
-    Each round prices the candidate moves of every segment length at once and applies a greedy set
-    of non-overlapping improving ones (restricted rounds, then a certifying full one).
+    The compiled local search (module docstring) with Or-opt moves only: first-improvement moves
+    from the neighbour lists, then full passes over every segment move until one finds none.
 
     Parameters
     ----------
@@ -584,7 +352,8 @@ def or_opt(cost, order, *, fixed_start: bool = True, segment_lengths=(1, 2, 3),
     segment_lengths : sequence of int
         The lengths of the segments that move.
     max_rounds : int, optional
-        Stop after this many rounds (None: at the Or-opt local optimum).
+        Make at most this many improving moves (None: at the Or-opt local optimum); see
+        :func:`two_opt`.
 
     Returns
     -------
@@ -607,13 +376,15 @@ def or_opt(cost, order, *, fixed_start: bool = True, segment_lengths=(1, 2, 3),
     p = _check_order(order, len(C))
     fixed_start = check_bool(fixed_start, "fixed_start")
     lengths = _check_lengths(segment_lengths)
-    search = _Search(C, fixed_start, lengths, max_rounds=_check_rounds(max_rounds))
-    return _unpad(search.descend(_pad(p, len(C), fixed_start), [search.or_opt_round]), fixed_start)
+    return _search(C, p, fixed_start, two_opt=False, lengths=lengths, max_rounds=_check_rounds(max_rounds))
 
 
 def improve(cost, order, *, fixed_start: bool = True, segment_lengths=(1, 2, 3),
             max_rounds: int | None = None) -> np.ndarray:
-    """2-opt to its local optimum, then Or-opt, again and again until neither improves.
+    """2-opt and Or-opt together until neither improves: the package's local search on a cost matrix.
+
+    A thin wrapper of the compiled search of ``ils``
+    (:meth:`~htetro_opt.solvers.sequencing._ils.LocalCore.descend`; module docstring).
 
     Parameters
     ----------
@@ -626,7 +397,8 @@ def improve(cost, order, *, fixed_start: bool = True, segment_lengths=(1, 2, 3),
     segment_lengths : sequence of int
         Or-opt's segment lengths.
     max_rounds : int, optional
-        Total budget of rounds of both moves (None: to the joint local optimum).
+        Make at most this many improving moves of either kind (None: to the joint local optimum);
+        see :func:`two_opt`.
 
     Returns
     -------
@@ -650,9 +422,7 @@ def improve(cost, order, *, fixed_start: bool = True, segment_lengths=(1, 2, 3),
     p = _check_order(order, len(C))
     fixed_start = check_bool(fixed_start, "fixed_start")
     lengths = _check_lengths(segment_lengths)
-    search = _Search(C, fixed_start, lengths, max_rounds=_check_rounds(max_rounds))
-    q = search.descend(_pad(p, len(C), fixed_start), [search.two_opt_round, search.or_opt_round])
-    return _unpad(q, fixed_start)
+    return _search(C, p, fixed_start, lengths=lengths, max_rounds=_check_rounds(max_rounds))
 
 
 def double_bridge(order, rng, *, fixed_start: bool = True) -> np.ndarray:
@@ -676,24 +446,24 @@ def double_bridge(order, rng, *, fixed_start: bool = True) -> np.ndarray:
     return np.concatenate([p[:a], p[b:c], p[a:b], p[c:]])
 
 
+
+
 def improve_batch(cost, orders, *, fixed_start: bool = True, segment_lengths=(1, 2, 3),
                   max_rounds: int | None = None, deadline: float = math.inf) -> np.ndarray:
-    """:func:`improve` for many orders at once, for the memetic GA's offspring.
-
-    Vectorised across the batch: each round applies the single best 2-opt move (then, once 2-opt
-    has converged for every order, the single best Or-opt move) of every order that still improves.
-    One move per round suits short paths; for long ones :func:`improve`, which applies many
-    non-overlapping moves per round, converges in far fewer rounds.
+    """:func:`improve` for many orders of one cost matrix, the search prepared once per first waypoint.
 
     Parameters
     ----------
     cost : array_like, shape (n, n)
     orders : array_like of int, shape (B, n)
         Permutations of 0…n−1.
-    fixed_start, segment_lengths, max_rounds
-        As :func:`improve` (``max_rounds``: the budget of rounds of each chunk of the batch).
+    fixed_start, segment_lengths
+        As :func:`improve`.
+    max_rounds : int, optional
+        The budget of improving moves of each order (None: to its local optimum).
     deadline : float
-        A ``time.perf_counter()`` instant after which no further round starts.
+        A ``time.perf_counter()`` instant after which no pass of the search starts: the orders not
+        reached by then come back as they were.
 
     Returns
     -------
@@ -723,112 +493,25 @@ def improve_batch(cost, orders, *, fixed_start: bool = True, segment_lengths=(1,
     deadline = check_real(deadline, "deadline (a time.perf_counter() instant)", finite=False)
     lengths = _check_lengths(segment_lengths)
     rounds = _check_rounds(max_rounds)
-    return _improve_rows(_padded_cost(C), _tolerance(C), P, fixed_start, lengths, rounds, deadline)
-
-
-def _improve_rows(D, tol, P, fixed_start, lengths=(1, 2, 3), rounds=math.inf, deadline=math.inf) -> np.ndarray:
-    """:func:`improve_batch` without the checks: ``D`` the padded cost, ``P`` (B, n) orders."""
-    n = len(D) - 1
-    if len(P) == 0 or n < 3:
-        return np.array(P, dtype=np.int64)
-    tail = np.full((len(P), 1), n, dtype=np.int64)
-    Qs = np.hstack([P, tail] if fixed_start else [tail, P, tail])
-    chunk = max(1, _BATCH_ELEMENTS // Qs.shape[1] ** 2)
-    for lo in range(0, len(Qs), chunk):
-        block = Qs[lo:lo + chunk]  # a view: the phases update it in place
-        budget = [rounds]
-        while True:
-            _batch_phase(D, block, tol, _batch_two_opt, budget, deadline)
-            if not _batch_phase(D, block, tol, lambda Q: _batch_or_opt(Q, lengths), budget, deadline):
-                break
-    return Qs[:, :-1] if fixed_start else Qs[:, 1:-1]
-
-
-def _batch_phase(D, Qs, tol, best_moves, budget: list, deadline) -> bool:
-    """Best-move rounds on the padded orders ``Qs`` (in place) until none improves or the shared
-    round ``budget`` runs out; True if any did."""
-    active = np.arange(len(Qs))
-    improved = False
-    while active.size and budget[0] > 0 and time.perf_counter() < deadline:
-        budget[0] -= 1
-        sub = Qs[active]
-        gain, source = best_moves(D[sub[:, :, None], sub[:, None, :]])
-        better = gain > tol
-        if not better.any():
-            break
-        improved = True
-        active = active[better]
-        Qs[active] = np.take_along_axis(sub[better], source[better], axis=1)
-    return improved
-
-
-def _batch_two_opt(Q: np.ndarray):
-    """Best 2-opt move of each padded order (Q: (B, m, m) costs in path order): gain and the
-    gather indices that apply it."""
-    B, m, _ = Q.shape
-    E = np.diagonal(Q, 1, axis1=1, axis2=2)
-    G = E[:, :, None] - Q[:, :-1, :-1]
-    G += E[:, None, :]
-    G -= Q[:, 1:, 1:]
-    G *= np.triu(np.ones((m - 1, m - 1), dtype=bool), 2)
-    flat = G.reshape(B, -1).argmax(1)
-    gain = G.reshape(B, -1)[np.arange(B), flat]
-    e1, e2 = np.divmod(flat, m - 1)
-    pos = np.arange(m)[None, :]
-    inside = (pos > e1[:, None]) & (pos <= e2[:, None])
-    source = np.where(inside, (e1 + 1 + e2)[:, None] - pos, pos)
-    return gain, source
-
-
-def _batch_or_opt(Q: np.ndarray, lengths):
-    """Best Or-opt move of each padded order: gain and the gather indices that apply it."""
-    B, m, _ = Q.shape
-    best = np.full(B, -np.inf)
-    move = np.zeros((B, 4), dtype=np.int64)  # i, L, k, reversed
-    E = np.diagonal(Q, 1, axis1=1, axis2=2)
-    K = m - 1
-    for L in lengths:
-        S = m - 1 - L
-        if S <= 0:
-            continue
-        i = np.arange(1, m - L)
-        removal = Q[:, i - 1, i] + Q[:, i + L - 1, i + L] - Q[:, i - 1, i + L]
-        insert = Q[:, 1:m - L, :K] + Q[:, L:m - 1, 1:m]
-        insert -= E[:, None, :]
-        flipped = np.zeros(insert.shape, dtype=bool)
-        if L > 1:
-            reverse = Q[:, L:m - 1, :K] + Q[:, 1:m - L, 1:m]
-            reverse -= E[:, None, :]
-            flipped = reverse < insert
-            np.minimum(insert, reverse, out=insert)
-        r = np.arange(S)[:, None]
-        kk = np.arange(K)[None, :]
-        insert[:, (kk >= r) & (kk <= r + L)] = np.inf
-        gain = removal[:, :, None] - insert
-        flat = gain.reshape(B, -1).argmax(1)
-        g = gain.reshape(B, -1)[np.arange(B), flat]
-        s, k = np.divmod(flat, K)
-        take = g > best
-        best = np.where(take, g, best)
-        rev = flipped.reshape(B, -1)[np.arange(B), flat]
-        move[take] = np.stack([i[s], np.full(B, L), k, rev], axis=1)[take]
-    i, L, k, rev = (move[:, c:c + 1] for c in range(4))
-    pos = np.arange(m)[None, :]
-    seg = np.where(rev == 1, i + L - 1 - (pos - (k + 1)), i + (pos - (k + 1)))  # when k < i
-    before = np.where(pos <= k, pos, np.where(pos <= k + L, seg, pos - L))
-    before = np.where(pos > i + L - 1, pos, before)
-    seg_after = np.where(rev == 1, i + L - 1 - (pos - (k - L + 1)), i + (pos - (k - L + 1)))
-    after = np.where(pos < i, pos, np.where(pos <= k - L, pos + L, np.where(pos <= k, seg_after, pos)))
-    source = np.where(k < i, before, after)
-    return best, source
+    out = P.copy()
+    if n < 3:
+        return out
+    cores = {}  # one prepared search per fixed start (its penalty pins that waypoint)
+    for r, p in enumerate(P):
+        first = int(p[0]) if fixed_start else None
+        if first not in cores:
+            cores[first] = _core(C, first)
+        out[r] = cores[first].descend(p, lengths=lengths, max_moves=rounds, deadline=deadline)
+    return out
 
 
 def solve_local(instance, *, seed=0, time_limit: float | None = None, restarts: int = 0,
                 max_starts: int = 32, progress=None) -> tuple[np.ndarray, dict]:
-    """Nearest neighbour, then 2-opt/Or-opt to a local optimum; optionally iterated local search.
+    """Nearest neighbour, then the compiled 2-opt/Or-opt search to a local optimum; optionally iterated.
 
     With ``restarts > 0``, each restart kicks the best order so far with a :func:`double_bridge`
-    drawn from the ``seed``'s generator, improves it again, and keeps it if it is cheaper.
+    drawn from the ``seed``'s generator, repairs it by the neighbour-list search (no full passes),
+    and keeps it if it is cheaper; the best order is then certified by the full passes.
 
     Parameters
     ----------
@@ -838,8 +521,9 @@ def solve_local(instance, *, seed=0, time_limit: float | None = None, restarts: 
         Seed of the kicks (unused without restarts): an int or a Generator reproduces a run (unless
         ``time_limit`` cuts it short), None draws fresh entropy.
     time_limit : float, optional
-        Wall-clock budget in seconds: no round or restart starts after it (the nearest-neighbour
-        construction always completes). None: 10 s + 1 s per 100 waypoints, at most 120 s.
+        Wall-clock budget in seconds: no pass of the search and no restart starts after it (the
+        nearest-neighbour construction, and a pass once begun, always complete). None: 10 s + 1 s
+        per 100 waypoints, at most 120 s.
     restarts : int
         Number of kicks of the iterated local search (0: plain local search).
     max_starts : int
@@ -851,8 +535,8 @@ def solve_local(instance, *, seed=0, time_limit: float | None = None, restarts: 
     -------
     order : ndarray of int64
     info : dict
-        ``initial_cost`` (nearest neighbour), ``local_optimum_cost`` (after the first
-        :func:`improve`), ``restarts`` (kicks done), ``improving_restarts`` and ``timed_out``.
+        ``initial_cost`` (nearest neighbour), ``local_optimum_cost`` (after the first descent),
+        ``restarts`` (kicks done), ``improving_restarts``, ``timed_out`` and ``time_limit_s``.
 
     Raises
     ------
@@ -878,13 +562,14 @@ def solve_local(instance, *, seed=0, time_limit: float | None = None, restarts: 
     began = time.perf_counter()
     deadline = began + time_limit
     C = _check_cost(instance.cost)
-    n = len(C)
     fixed = instance.start is not None
+    tol = _tolerance(C)
     order = nearest_neighbour(C, start=instance.start, max_starts=max_starts)
     info = {"initial_cost": float(_path_cost(C, order))}
-    search = _Search(C, fixed, deadline=deadline)
-    moves = [search.two_opt_round, search.or_opt_round]
-    best = _unpad(search.descend(_pad(order, n, fixed), moves), fixed)
+    # the open path from the instance's start (a closed tour or a fixed end reaches this method as
+    # the dispatcher's open-path reduction)
+    core = _core(C, instance.start) if len(C) >= 3 else None
+    best = order if core is None else core.descend(order, deadline=deadline)
     best_cost = _path_cost(C, best)
     info["local_optimum_cost"] = float(best_cost)
     done = improving = 0
@@ -892,14 +577,14 @@ def solve_local(instance, *, seed=0, time_limit: float | None = None, restarts: 
     while done < restarts and time.perf_counter() < deadline:
         done += 1
         kicked = double_bridge(best, rng, fixed_start=fixed)
-        # a kick changes four edges: the restricted rounds repair it; the best order is certified below
-        candidate = _unpad(search.descend(_pad(kicked, n, fixed), moves, certify=False), fixed)
+        # a kick changes three edges: the neighbour-list search repairs it; the best order is certified below
+        candidate = kicked if core is None else core.descend(kicked, certify=False, deadline=deadline)
         cost = _path_cost(C, candidate)
-        if cost < best_cost - search.tol:
+        if cost < best_cost - tol:
             best, best_cost, improving = candidate, cost, improving + 1
         report(progress, done, restarts, f"best cost {best_cost:.4g}")
     if improving:
-        best = _unpad(search.descend(_pad(best, n, fixed), moves), fixed)
+        best = core.descend(best, deadline=deadline)
     info.update(restarts=done, improving_restarts=improving, timed_out=time.perf_counter() >= deadline,
                 time_limit_s=time_limit)
     return best, info

@@ -96,8 +96,10 @@ def improving_reversal(cost, order, fixed):
     return None
 
 
-def improving_segment_move(cost, order, fixed, lengths=(1, 2, 3)):
-    """Some move of a segment (as is or reversed) elsewhere that is cheaper, or None."""
+def improving_segment_move(cost, order, fixed, lengths=(1, 2, 3), elsewhere=False):
+    """Some move of a segment (as is or reversed) elsewhere that is cheaper, or None. ``elsewhere``:
+    not back where it was (reversed in place it is a 2-opt move, which Or-opt of other lengths than
+    1–3 does not make)."""
     order = list(np.asarray(order).tolist())
     base = path_cost(cost, order)
     lo = 1 if fixed else 0
@@ -105,6 +107,8 @@ def improving_segment_move(cost, order, fixed, lengths=(1, 2, 3)):
         for i in range(lo, len(order) - L + 1):
             seg, rest = order[i:i + L], order[:i] + order[i + L:]
             for k in range(lo, len(rest) + 1):
+                if elsewhere and k == i:
+                    continue
                 for s in (seg, seg[::-1]):
                     if path_cost(cost, rest[:k] + s + rest[k:]) < base - TOL:
                         return i, L, k
@@ -151,9 +155,23 @@ def test_moves_never_worsen_keep_the_start_and_reach_their_local_optimum(gen, n,
             assert find(cost, out, fixed) is None, (move.__name__, find.__name__)
 
 
+@pytest.mark.parametrize("lengths", [(3,), (2, 4)])
+@pytest.mark.parametrize("n", [3, 4, 5, 7, 9, 11])
+def test_or_opt_of_other_segment_lengths_reaches_its_local_optimum(n, lengths):
+    # without lengths 1 and 2 no other move stands in for a segment moved just before its
+    # neighbour's neighbour, or (in a path of the segment and two more waypoints) to the far end
+    for gen, seed, fixed in itertools.product((euclidean, random_symmetric), range(4), (True, False)):
+        cost = gen(n, seed)
+        start = np.random.default_rng(seed + 7).permutation(n)
+        out = or_opt(cost, start, fixed_start=fixed, segment_lengths=lengths)
+        assert is_permutation(out, n) and path_cost(cost, out) <= path_cost(cost, start) + TOL
+        assert not fixed or out[0] == start[0]
+        assert improving_segment_move(cost, out, fixed, lengths, elsewhere=True) is None, (gen.__name__, seed, fixed)
+
+
 @pytest.mark.parametrize("fixed", [True, False])
-def test_restricted_rounds_are_certified_on_a_larger_instance(fixed):
-    # 120 waypoints: the neighbour-list rounds do most of the work, the full rounds certify
+def test_neighbour_list_moves_are_certified_on_a_larger_instance(fixed):
+    # 120 waypoints: the neighbour-list search does most of the work, the full passes certify
     cost = euclidean(120, 3)
     start = nearest_neighbour(cost, start=0 if fixed else None)
     out = two_opt(cost, start, fixed_start=fixed)
@@ -223,6 +241,19 @@ def test_nearest_neighbour_is_greedy_and_the_free_start_is_the_best_of_all_start
     free = nearest_neighbour(cost)
     assert path_cost(cost, free) == pytest.approx(min(path_cost(cost, naive_nearest_neighbour(cost, s))
                                                       for s in range(12)))
+
+
+def test_importing_the_local_search_does_not_import_numba():
+    # the exact solver and the greedy baseline import the module for the construction; numba (about
+    # half a second) is imported when a search first runs
+    import subprocess
+    import sys
+
+    code = ("import sys, htetro_opt.solvers.sequencing as s; s.improve, s.solve_local, s.nearest_neighbour; "
+            "before = 'numba' in sys.modules; s.improve([[0, 1, 2], [1, 0, 1], [2, 1, 0]], [0, 2, 1]); "
+            "print(before, 'numba' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["False", "True"]
 
 
 def test_double_bridge_is_a_permutation_keeping_the_start():
