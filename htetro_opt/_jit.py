@@ -1,25 +1,55 @@
-"""Compiling a hot loop with numba on its first call, so that importing a module never imports numba.
+"""numba, a core dependency: the one place that imports it, and compiling a hot loop on its first call.
 
 numba is a core dependency, but importing it costs about half a second: the model, the problems
 and the operators are imported by every command of the CLI and by the tiler, which mostly never run
 these loops. A loop wrapped by :func:`lazy_jit` is compiled (``cache=True``: later processes load it
-from numba's on-disk cache) the first time it is called; without numba it runs as Python, with the
-same results.
+from numba's on-disk cache) the first time it is called. The modules made of compiled kernels
+(``ils``'s, the tiler's sweep), imported only when they run, take numba from :func:`require_numba`
+when they are imported. There is no pure-Python fallback: without numba these raise a
+:class:`~htetro_opt.errors.DependencyError` that says how to install it.
 """
 
 from __future__ import annotations
 
 import functools
 
-__all__ = ["lazy_jit"]
+from htetro_opt.errors import DependencyError
+
+__all__ = ["lazy_jit", "require_numba"]
+
+
+def require_numba():
+    """The ``numba`` module, or a clear error: numba is a core dependency.
+
+    Returns
+    -------
+    module
+        ``numba``.
+
+    Raises
+    ------
+    DependencyError
+        If numba cannot be imported (not installed, or broken): an ``ImportError`` too, naming the
+        install command.
+
+    Examples
+    --------
+    >>> require_numba().__name__
+    'numba'
+    """
+    try:
+        import numba
+    except ImportError as err:
+        raise DependencyError(
+            "numba is a core dependency of htetro-opt (it compiles the sequencing local search, the "
+            "tiler's sweep and the simulator's and operators' hot loops), and it cannot be imported "
+            f"({err}): install it with pip install 'numba>=0.59', or reinstall htetro-opt",
+            name="numba") from err
+    return numba
 
 
 def _njit(function):
-    try:
-        import numba
-    except ImportError:  # pragma: no cover - numba is a core dependency
-        return function
-    return numba.njit(cache=True, nogil=True)(function)
+    return require_numba().njit(cache=True, nogil=True)(function)
 
 
 def lazy_jit(function=None, *, calls: tuple[str, ...] = ()):

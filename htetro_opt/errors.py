@@ -22,6 +22,7 @@ __all__ = [
     "OutputError",
     "StudyError",
     "WorkerLost",
+    "DependencyError",
 ]
 
 
@@ -102,3 +103,8 @@ class StudyError(ParameterError):
 class WorkerLost(HtetroError, RuntimeError):
     """A worker process of a study's ``processes`` executor died (killed, out of memory): the trials
     recorded so far are kept, and ``resume=True`` continues the study."""
+
+
+class DependencyError(HtetroError, ImportError):
+    """A core dependency of htetro-opt is missing or cannot be imported (a broken install): the
+    message names it and how to install it."""

@@ -41,12 +41,13 @@ Stützle 2003):
   says so (``info["timed_out"]``) and is no longer reproducible.
 
 The kernel is compiled by numba (≥ 0.59, a core dependency, so that ``auto`` gives the same order on
-every install). :class:`LocalCore` runs the same local search on given orders: it is the package's
-one 2-opt / Or-opt local search, the memetic GA's local step (:meth:`LocalCore.improve`) and, with
-the full passes (:meth:`LocalCore.descend`), the ``local`` method's and
-:func:`~htetro_opt.solvers.sequencing.improve`'s. Should numba be missing,
-``ils`` runs the pure-numpy ``local`` method with restarts under the same time cap instead, and says
-so in ``info["engine"]``: its results are worse (benchmarks/README.md) and depend on the clock.
+every install; without it importing this module raises
+:class:`~htetro_opt.errors.DependencyError`, :func:`htetro_opt._jit.require_numba`). This module
+is imported when a search first runs, never by importing :mod:`htetro_opt.solvers.sequencing`.
+:class:`LocalCore` runs the same local search on given orders: it is the package's one 2-opt /
+Or-opt local search, the memetic GA's local step (:meth:`LocalCore.improve`) and, with the full
+passes (:meth:`LocalCore.descend`), the ``local`` method's and
+:func:`~htetro_opt.solvers.sequencing.improve`'s.
 """
 
 from __future__ import annotations
@@ -56,12 +57,13 @@ import time
 
 import numpy as np
 
+from htetro_opt._jit import require_numba
 from htetro_opt._validation import as_rng, check_int, check_time_limit
 from htetro_opt.errors import ParameterError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance, eq2_legs
 from htetro_opt.solvers.sequencing._budgets import default_time_limit
 
-__all__ = ["HAVE_NUMBA", "ILS_KICK_SPAN", "ILS_NEIGHBOURS", "LocalCore", "ils_kicks", "solve_ils"]
+__all__ = ["ILS_KICK_SPAN", "ILS_NEIGHBOURS", "LocalCore", "ils_kicks", "solve_ils"]
 
 ILS_NEIGHBOURS = 8
 """Size of each node's neighbour (candidate) list."""
@@ -72,21 +74,10 @@ ILS_KICK_SPAN = 100
 _UNLIMITED = 1 << 62
 """A move budget that never runs out."""
 
-try:  # pragma: no cover - depends on the environment
-    import numba
+numba = require_numba()  # the kernels below are compiled at their first call
+from numba.extending import overload  # noqa: E402 - only once numba is known to import
 
-    from numba.extending import overload
-
-    _jit = numba.njit(cache=True, nogil=True)
-    HAVE_NUMBA = True
-except ImportError:  # pragma: no cover
-    numba = None
-
-    def _jit(function):
-        return function
-
-    HAVE_NUMBA = False
-"""Whether numba is installed: ``ils`` runs its compiled kernel, else the ``local`` fallback."""
+_jit = numba.njit(cache=True, nogil=True)
 
 
 def ils_kicks(n: int) -> int:
@@ -213,14 +204,13 @@ def _eq2(cm, a, b):
     return total
 
 
-if HAVE_NUMBA:
-    # Chosen by type when the kernel compiles, so a dense matrix costs one load, as if written inline:
-    # a run-time branch between the two (or a call LLVM does not inline) made the kernel 8x slower.
-    @overload(_d, jit_options={"cache": True})
-    def _d_compiled(cm, a, b):
-        if isinstance(cm, numba.types.Array):
-            return lambda cm, a, b: cm[a, b]
-        return _eq2
+# Chosen by type when the kernel compiles, so a dense matrix costs one load, as if written inline:
+# a run-time branch between the two (or a call LLVM does not inline) made the kernel 8x slower.
+@overload(_d, jit_options={"cache": True})
+def _d_compiled(cm, a, b):
+    if isinstance(cm, numba.types.Array):
+        return lambda cm, a, b: cm[a, b]
+    return _eq2
 
 
 @_jit
@@ -644,9 +634,9 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     -------
     order : ndarray of int64
     info : dict
-        ``engine`` (``"numba"``, or the fallback), ``costs`` (``"matrix"`` or implicit), ``kicks``
-        (done), ``improving_kicks``, ``timed_out``, ``initial_cost`` (the start tour, on the closed
-        tour), ``tour_cost``.
+        ``engine`` (``"numba"``, or ``"enumeration"`` below 8 nodes), ``costs`` (``"matrix"`` or
+        implicit), ``kicks`` (done), ``improving_kicks``, ``timed_out``, ``initial_cost`` (the start
+        tour, on the closed tour), ``tour_cost``.
 
     Raises
     ------
@@ -674,8 +664,6 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     rng = as_rng(seed)
     stream = int(rng.integers(0, 2**63))
     began = time.perf_counter()
-    if not HAVE_NUMBA:
-        return _fallback(instance, rng, time_limit)
     cm, m, dummy, top = _cost_model(instance)
     if kicks is None:
         kicks = ils_kicks(m)
@@ -775,7 +763,7 @@ class LocalCore:
         8 nodes (where ``ils`` enumerates instead; the memetic GA's results on tiny instances stay
         those it has always given)."""
         order = self.instance.check_order(order)
-        if self.m < 8 or not HAVE_NUMBA:
+        if self.m < 8:
             return order
         tour = order if self.dummy is None else np.append(order, self.dummy)
         tour = np.ascontiguousarray(tour, dtype=np.int64)
@@ -831,11 +819,3 @@ class LocalCore:
             if made == 0 or budget <= 0 or time.perf_counter() >= deadline:
                 break
         return _as_directed(_decode(tour, self.dummy, self.instance), order, self.instance)
-
-
-def _fallback(instance, rng, time_limit):
-    """Without numba: ``local`` with restarts under the cap (its default time budget when None)."""
-    from htetro_opt.solvers.sequencing._dispatch import sequence_waypoints
-
-    result = sequence_waypoints(instance, method="local", seed=rng, time_limit=time_limit, restarts=10**9)
-    return result.order, {**result.info, "engine": "local (numba is not installed)"}

@@ -11,22 +11,19 @@ which
 - an uncovered cell next to the new tile belongs to an enclosed pocket of at most ``pocket`` cells
   whose area is not a multiple of 4.
 
-Compiled by numba (a core dependency) so that a sweep takes milliseconds on a 256 × 256 grid; it is
-deterministic: the same grid and pattern order give the same tiles. The grid is the backtracker's
-padded flat byte grid (internal rows top first, so the flat index is the scan order).
+Compiled by numba (a core dependency; without it importing this module raises
+:class:`~htetro_opt.errors.DependencyError`) so that a sweep takes milliseconds on a 256 × 256 grid;
+it is deterministic: the same grid and pattern order give the same tiles. The grid is the
+backtracker's padded flat byte grid (internal rows top first, so the flat index is the scan order).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-try:  # pragma: no cover - numba is a core dependency; the fallback keeps a broken install usable
-    import numba
+from htetro_opt._jit import require_numba
 
-    _jit = numba.njit(cache=True, nogil=True)
-except ImportError:  # pragma: no cover
-    def _jit(function):
-        return function
+_jit = require_numba().njit(cache=True, nogil=True)  # compiled at each kernel's first call
 
 __all__ = ["sweep", "dead_cells"]
 

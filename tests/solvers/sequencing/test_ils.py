@@ -16,8 +16,6 @@ from htetro_opt.solvers.sequencing import (
     sequence_waypoints,
 )
 
-pytest.importorskip("numba")
-
 
 def euclidean(n, seed):
     xy = np.random.default_rng(seed).random((n, 2)) * 100
