@@ -427,13 +427,31 @@ class TaskSpec:
                 raise ParameterError(f"method {m.name!r} takes no option {key!r}: its options are {listed}")
             label = self.label(key, naming)
             if key not in own:
-                raise ParameterError(f"{label} applies to {self.describe(self.taking(key))} only, not to {m.name}")
+                scope = f"{label} applies to {self.describe(self.taking(key))} only"
+                if key in m.problem:  # its problem has a fixed value of it (the heat planner's diagonals)
+                    scope += f" ({m.name} always plans with {key} {_words(m.problem[key])})"
+                if naming == "keyword":  # a library call: the method's options, as for a typo
+                    listed = ", ".join(own) or "none"
+                    raise ParameterError(f"method {m.name!r} takes no option {key!r} ({scope}): its options are {listed}")
+                raise ParameterError(f"{scope}, not to {m.name}")
             out[key] = option.check(value, label)
         if fill:
             for name in own:
                 if name not in out:
                     out[name] = self.default_of(m, name)
         return out
+
+    def applicable(self, method: str | Method, **options) -> dict:
+        """Of ``options``, those ``method`` takes: one set of options for a loop over methods that differ.
+
+        Examples
+        --------
+        >>> from htetro_opt.solvers.sequencing import SPEC
+        >>> SPEC.applicable("ga", seed=0, time_limit=2), SPEC.applicable("zigzag", seed=0, time_limit=2)
+        ({'seed': 0, 'time_limit': 2}, {})
+        """
+        m = method if isinstance(method, Method) else self.method(method)
+        return {k: v for k, v in options.items() if m.takes(k)}
 
     def split(self, method: str | Method, options: Mapping[str, Any]) -> tuple[dict, dict]:
         """``options`` as (problem options, method options), by each option's stage (unknown ones in
@@ -527,7 +545,7 @@ class TaskSpec:
         scope = "" if set(takers) >= set(methods or self.methods) else f"{self.describe(takers, members=False)}: "
         if opt.switch:
             return f"{scope}{opt.help}"
-        return f"{scope}{opt.help} (default: {self.default_words(option)})"
+        return f"{scope}{opt.help} (default {self.default_words(option)})"
 
     def method_help(self) -> str:
         """``--method``'s help: every method with its summary, the default first."""

@@ -2,7 +2,8 @@
 
 Each check takes the value and the name the user knows it by (a keyword, or a CLI flag), returns
 the value in its canonical type, and raises :class:`~htetro_opt.errors.ParameterError` naming both
-the option and the value. ``bool`` is never accepted as a number: ``True`` passed for a size is a
+the option and the value. A name that is a flag (``--seed``) gets the command line's words: what can
+be typed there, no None, no Generator. ``bool`` is never accepted as a number: ``True`` passed for a size is a
 mistake, not a 1.
 
 Randomness has one meaning everywhere (networkx's rule): ``seed=None`` draws fresh entropy; an int
@@ -44,9 +45,14 @@ def check_int(value, name: str, *, minimum: int | None = None, maximum: int | No
         value = int(value)
         bad = (minimum is not None and value < minimum) or (maximum is not None and value > maximum)
     if bad:
-        raise ParameterError(f"{name} must be {_int_range(minimum, maximum)}{' or None' if allow_none else ''}, "
+        raise ParameterError(f"{name} must be {_int_range(minimum, maximum)}{_or_none(name, allow_none)}, "
                              f"got {value!r}")
     return value
+
+
+def _or_none(name: str, allow_none: bool) -> str:
+    """" or None" where None is a value the user can give (not on the command line, where it is a flag left out)."""
+    return " or None" if allow_none and not name.startswith("--") else ""
 
 
 def _int_range(minimum, maximum) -> str:
@@ -90,7 +96,7 @@ def check_real(value, name: str, *, minimum: float | None = None, maximum: float
         if maximum is not None:
             bounds.append(f"{'<=' if include_maximum else '<'} {maximum:g}")
         what = ("a finite number" if finite else "a number") + (" " + " and ".join(bounds) if bounds else "")
-        raise ParameterError(f"{name} must be {what}{' or None' if allow_none else ''}, got {value!r}")
+        raise ParameterError(f"{name} must be {what}{_or_none(name, allow_none)}, got {value!r}")
     return value
 
 
@@ -143,8 +149,8 @@ def check_time_limit(value, name: str = "time_limit") -> float | None:
         return None
     ok = not isinstance(value, (bool, np.bool_)) and isinstance(value, numbers.Real) and 0 < value <= MAX_TIME_LIMIT
     if not ok:
-        raise ParameterError(f"{name} must be a positive, finite number of seconds (at most {MAX_TIME_LIMIT:g}) "
-                             f"or None, got {value!r}")
+        raise ParameterError(f"{name} must be a positive, finite number of seconds (at most {MAX_TIME_LIMIT:g})"
+                             f"{_or_none(name, True)}, got {value!r}")
     return float(value)
 
 
@@ -161,6 +167,8 @@ def check_seed(seed, name: str = "seed"):
     if seed is None or isinstance(seed, np.random.Generator):
         return seed
     if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, numbers.Integral) or seed < 0:
+        if name.startswith("--"):
+            raise ParameterError(f"{name} must be a non-negative integer, got {seed!r}")
         raise ParameterError(f"{name} must be None, a non-negative integer or a numpy.random.Generator, got {seed!r}")
     return int(seed)
 

@@ -47,12 +47,11 @@ class Result(ABC):
         """The task's own fields, JSON-ready, in the order ``as_dict`` lists them."""
 
     def as_dict(self) -> dict:
-        """JSON-ready: ``method``, ``success``, ``message``, ``runtime_s``, the task's own fields, and ``info``
-        (every non-finite number None: strict JSON has no infinity)."""
+        """JSON-ready: ``method``, ``success``, ``message``, ``runtime_s``, ``info`` (every non-finite number
+        None: strict JSON has no infinity), then the task's own fields."""
         out = {"method": self.method, "success": bool(self.success), "message": self.message,
-               "runtime_s": round(float(self.runtime_s), 6)}
+               "runtime_s": round(float(self.runtime_s), 6), "info": jsonable(dict(self.info))}
         out.update(self._fields())
-        out["info"] = jsonable(dict(self.info))
         return out
 
 

@@ -19,7 +19,7 @@ from typing import Any
 from htetro_opt._spec import TaskSpec
 from htetro_opt._validation import check_int
 from htetro_opt.errors import HtetroError, ParameterError, StudyError
-from htetro_opt.studies._trial import Trial, reference_trial, spec_of
+from htetro_opt.studies._trial import Trial, _plain, reference_trial, spec_of
 
 __all__ = ["METRICS", "TASKS", "MethodEntry", "Study", "list_studies", "load_study"]
 
@@ -272,8 +272,8 @@ def _check_options(task: str, spec: TaskSpec, method: str, options, scenarios, w
                              "a method entry takes none")
         if key in spec.options and not spec.options[key].study:
             raise StudyError(f"{where}: {key} cannot be set in a study file (a library option)")
-    try:
-        out = spec.check(method, options, naming="key", fill=False)
+    try:  # as JSON holds them (a tuple of weights as a list): a trial's key hashes them, its record keeps them
+        out = {k: _plain(v) for k, v in spec.check(method, options, naming="key", fill=False).items()}
     except ParameterError as err:
         raise StudyError(f"{where}: {err}") from err
     if task == "cover" and "stripes" in out:

@@ -111,7 +111,9 @@ def reference_trial(trial: Trial) -> Trial:
     parameters = {k: v for k, v in trial.parameters.items() if spec.options[k].reference and exact.takes(k)}
     if method is not None:
         parameters.update({k: v for k, v in method.problem.items() if exact.takes(k)})
-    parameters = {k: parameters[k] for k in sorted(parameters)}
+    # a value the exact method has by default is left out, so that trials of one problem share one reference
+    parameters = {k: _plain(parameters[k]) for k in sorted(parameters)
+                  if _plain(parameters[k]) != _plain(spec.default_of(exact, k))}
     return Trial(trial.task, trial.scenario, exact.name, parameters, None, "reference", (), "reference")
 
 

@@ -159,16 +159,16 @@ def _cli(capsys, argv):
 
 
 def test_the_cli_passes_the_window(capsys, monkeypatch):
-    import htetro_opt.cli as cli
+    import htetro_opt.solvers.grid_paths._dispatch as dispatch
 
     given = {}
-    real = cli.plan_path
+    real = dispatch.plan_path
 
     def spy(workspace, roadmap, **options):
         given.update(options)
         return real(workspace, roadmap, **{**options, "pop_size": 4, "max_gen": 2})
 
-    monkeypatch.setattr(cli, "plan_path", spy)
+    monkeypatch.setattr(dispatch, "plan_path", spy)
     code, _, err = _cli(capsys, ["plan", "h_shape", "--method", "htetro-ga", "--polish-window", "12", "--json"])
     assert code == 0, err
     assert given["polish_window"] == 12

@@ -109,7 +109,7 @@ BAD = {
     "time limit infinite": ("time_limit = inf\n", ["time_limit", "inf"]),
     "unknown start": ('start = "middle"\n', ["start", "'scenario'", "'auto'", "'middle'"]),
     "negative clearance": ("clearance = -1\n", ["clearance", "-1"]),
-    "another task's option": ("pop_size = 10\n", ["unknown option 'pop_size'", "task cover"]),
+    "another task's option": ("pop_size = 10\n", ["takes no option 'pop_size'", "its options are shapes, start"]),
     "stripes for the boustrophedon": ('[[methods]]\nmethod = "boustrophedon"\nstripes = 4\n',
                                       ["methods[1]", "stripes applies to the stripes methods", "not to boustrophedon"]),
     "budget for tiling-tsp": ('[[methods]]\nmethod = "tiling-tsp"\nbudget = 100\n',
@@ -331,8 +331,11 @@ def test_command_line_runs_a_cheng2019_study_file(tmp_path, capsys):
     assert "--figures applies to cheng2019 only" in capsys.readouterr().err
 
 
-def test_python_m_entry_point_refuses_bad_options(capsys):
-    assert cheng2019.main(["--resume"]) == 2
+def test_the_one_command_line_refuses_bad_options(capsys):
+    from htetro_opt.cli import main
+
+    assert main(["study", "cheng2019", "--resume"]) == 2
     assert "error: --resume needs --out DIR" in capsys.readouterr().err
-    assert cheng2019.main(["--jobs", "0"]) == 2
-    assert "--jobs" in capsys.readouterr().err
+    assert main(["study", "cheng2019", "--workers", "0"]) == 2
+    assert "--workers" in capsys.readouterr().err
+    assert not hasattr(cheng2019, "main")  # one command line: htetro-opt study

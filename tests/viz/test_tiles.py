@@ -21,7 +21,7 @@ CELL_LABEL = re.compile(r"^\d+[abcd](/\d+[abcd])*$")
 
 @pytest.fixture(scope="module")
 def large():
-    tileset = tile_workspace(load_scenario("tiling_64x64").workspace, name="tiling_64x64")
+    tileset = tile_workspace(load_scenario("tiling_64x64").workspace, name="tiling_64x64").tileset
     assert len(tileset) == 1004
     return tileset
 

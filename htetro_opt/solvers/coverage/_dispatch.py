@@ -152,7 +152,11 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
     parsed = parse_layers(layers)
     if method == "boustrophedon":
         parsed = parsed[:1]
-    widths = stripe_widths(options["stripes"], workspace.height) if "stripes" in options else None
+    # the auto start prefers the first stripe; a method without stripes that of the default width where it fits,
+    # so that every method starts from the same pose
+    default = SPEC.options["stripes"].default
+    widths = stripe_widths(options["stripes"], workspace.height) if "stripes" in options else \
+        stripe_widths(default, workspace.height) if default <= workspace.height else None
     time_limit = options.get("time_limit")
     lg = LayerGraph(workspace, parsed, clearance=clearance)
     start_node = auto_start(lg, widths) if start is None else check_end(lg, start, "start")

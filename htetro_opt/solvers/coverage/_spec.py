@@ -35,6 +35,13 @@ def _choice(choices):
     return check
 
 
+def _start(value, name):
+    if value not in STARTS:
+        raise ParameterError(f"{name} must be 'scenario' (the roadmap's first and last poses) or 'auto' (the "
+                             f"bottom-left pose of the first layer, a free end), got {value!r}")
+    return value
+
+
 def _layers(value, name):
     """A morphology set: ``"O,vI"`` or ``["O", "vI"]`` (any form of ``parse_layers``), as its layers' names
     joined by commas."""
@@ -71,7 +78,7 @@ def _stripes(value, name):
 OPTIONS = (
     Option("shapes", _layers, "morphology layers: O, vI, hI or SHAPE@H, comma-separated", default=",".join(DEFAULT_LAYERS),
            stage="problem", metavar="LAYERS"),
-    Option("start", _choice(STARTS), "scenario: the roadmap's first pose as start and last as goal (auto when the "
+    Option("start", _start, "scenario: the roadmap's first pose as start and last as goal (auto when the "
            "scenario has none); auto: the bottom-left pose of the first layer, a free end", default="scenario",
            stage="problem", choices=STARTS),
     Option("clearance", lambda v, n: check_real(v, n, minimum=0.0), "clearance δ in cells around every block",

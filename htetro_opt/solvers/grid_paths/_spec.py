@@ -100,7 +100,7 @@ OPTIONS = (
            "the minimum-time path between its ends; 0 off", type=int, metavar="W"),
     Option("replan_members", _int(0), "random goal-reaching members re-planned each generation besides the "
            "fastest", default=3, type=int, metavar="K"),
-    Option("reach_share", _real(0.0, above=True), "cap on the goal-reaching section of the hTetro-GA's sort, a "
+    Option("reach_share", lambda v, n: check_real(v, n, minimum=0.0, include_minimum=False, maximum=1.0), "cap on the goal-reaching section of the hTetro-GA's sort, a "
            "share in (0, 1] of n_pop (ours; 1: the paper's sort)", default=1.0, type=float, metavar="S"),
     Option("reach_patience", _int(0), "reach repair (ours): when no member has reached the goal and the best "
            "goal reachability has not risen for N generations, the member nearest to the goal gets the "

@@ -62,11 +62,9 @@ from htetro_opt._validation import as_rng, check_int, check_time_limit
 from htetro_opt.errors import ParameterError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance, eq2_legs
 from htetro_opt.solvers.sequencing._budgets import default_time_limit
+from htetro_opt.solvers.sequencing._spec import ILS_NEIGHBOURS
 
-__all__ = ["ILS_KICK_SPAN", "ILS_NEIGHBOURS", "LocalCore", "ils_kicks", "solve_ils"]
-
-ILS_NEIGHBOURS = 8
-"""Size of each node's neighbour (candidate) list."""
+__all__ = ["ILS_KICK_SPAN", "LocalCore", "ils_kicks", "solve_ils"]
 
 ILS_KICK_SPAN = 100
 """Longest segment of a kick's double bridge (each of its three segments has 1…this many nodes)."""

@@ -85,20 +85,23 @@ def _end(value, name):
 
 
 def _weights(value, name):
+    """Eq. 2's four weights: numbers in [0, 1e6] (huge ones overflow the costs) with a positive sum; the command
+    line's text "a,b,c,d" too."""
     from htetro_opt.problems.waypoint_sequencing import check_weights  # light: numpy only
 
-    if isinstance(value, str):  # the command line's "0.4,0.2,0.2,0.2"
+    text = value
+    if isinstance(value, str):
         try:
             value = [float(v) for v in value.split(",")]
         except ValueError:
-            raise ParameterError(f"{name} must be four comma-separated numbers a,b,c,d, got {value!r}") from None
+            raise ParameterError(f"{name} must be four comma-separated numbers a,b,c,d, got {text!r}") from None
     if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 4:
-        raise ParameterError(f"{name} must be four numbers a,b,c,d, got {value!r}")
-    values = [check_real(v, f"{name}[{i}]", minimum=0.0, maximum=1e6) for i, v in enumerate(value)]
+        raise ParameterError(f"{name} must be four numbers a,b,c,d, got {text!r}")
     try:
+        values = [check_real(v, f"{name}[{i}]", minimum=0.0, maximum=1e6) for i, v in enumerate(value)]
         return tuple(float(v) for v in check_weights(values))
-    except ParameterError as err:
-        raise ParameterError(f"{name}: {err}") from None
+    except ParameterError:
+        raise ParameterError(f"{name} must be four numbers in [0, 1e6] with a positive sum, got {text!r}") from None
 
 
 def _shapes(value, name):
@@ -211,8 +214,8 @@ def _pose(source, *, label, start, end, closed, weights, shapes) -> Problem:
                 raise ParameterError(f"{label(name)} does not apply to a TSPLIB file (it has no tiles)")
         closed = True if closed is None else closed
         if closed and end is not None:
-            raise ParameterError(f"{label('end')} applies to open paths (a TSPLIB file is a closed tour unless asked "
-                                 "for an open path)")
+            raise ParameterError(f"{label('end')} applies to open paths: a TSPLIB file is a closed tour unless asked for "
+                                 "an open path (--open on the command line, closed=False in a call or a study)")
         nodes = range(1, loaded.dimension + 1)
         instance = SequencingInstance.from_matrix(loaded.cost, closed=closed,
                                                   start=_index(start, nodes, label("start"), "node"),

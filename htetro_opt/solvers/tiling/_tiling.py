@@ -116,8 +116,7 @@ class TilingResult(Result):
     """A tiling, labelled: the :class:`~htetro_opt.scenarios.Tileset` and how it was made.
 
     ``tileset`` holds the tiles (numbered 1, 2, … in scan order, each labelled by a robot footprint);
-    ``info`` holds ``shapes`` (tiles per morphology) and ``overlapping`` (the map was covered by two
-    overlapping sub-workspaces). A map that cannot be tiled raises instead (a
+    ``shapes`` counts them by morphology. A map that cannot be tiled raises instead (a
     :class:`~htetro_opt.errors.TilingError` is a proof that no tiling exists), so ``success`` is True.
     """
 
@@ -127,18 +126,23 @@ class TilingResult(Result):
     info: Mapping = field(default_factory=dict)
 
     @property
+    def shapes(self) -> dict[str, int]:
+        """Tiles per morphology, the morphologies in alphabetical order."""
+        return {shape: self.tileset.shapes.count(shape) for shape in sorted(set(self.tileset.shapes))}
+
+    @property
     def success(self) -> bool:
         return True
 
     @property
     def message(self) -> str:
-        counts = ", ".join(f"{k} {v}" for k, v in self.info["shapes"].items())
+        counts = ", ".join(f"{k} {v}" for k, v in self.shapes.items())
         twice = " (two overlapping sub-workspaces)" if self.tileset.overlapping else ""
         return f"{len(self.tileset)} tiles: {counts}{twice}"
 
     def _fields(self) -> dict:
-        return {"tiles": len(self.tileset), "shapes": dict(self.info["shapes"]),
-                "overlapping": bool(self.tileset.overlapping), "complete": bool(self.tileset.complete)}
+        return {"tiles": len(self.tileset), "shapes": self.shapes, "overlapping": bool(self.tileset.overlapping),
+                "complete": bool(self.tileset.complete)}
 
 # ------------------------------------------------------------------------------------------------
 # Validation
@@ -377,9 +381,7 @@ def tile_workspace(workspace, *, method: str = SPEC.default, **options) -> Tilin
 
 
 def _result(tileset: Tileset, method: str, began: float) -> TilingResult:
-    counts = {shape: tileset.shapes.count(shape) for shape in sorted(set(tileset.shapes))}
-    return TilingResult(tileset, method, _time.perf_counter() - began,
-                        {"shapes": counts, "overlapping": bool(tileset.overlapping)})
+    return TilingResult(tileset, method, _time.perf_counter() - began)
 
 
 def enumerate_tilings(workspace, *, shapes=None, limit: int = 10, method: str = "auto",

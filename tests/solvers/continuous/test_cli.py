@@ -26,27 +26,29 @@ def test_json_keys_per_method(capsys, method, extra):
     code, out, err = run(capsys, "ega08_slits2", "--method", method, "--json", *extra)
     assert code == 0, err
     data = json.loads(out)
-    keys = {"scenario", "method", "reached", "paths", "objectives", "min_robot_distance", "conflicts", "runtime_s",
-            "info"}
+    keys = {"scenario", "method", "success", "message", "reached", "paths", "objectives", "min_robot_distance",
+            "conflicts", "runtime_s", "info"}
     assert set(data) == keys | ({"front"} if method == "nsga2" else set())
     assert data["reached"] and data["method"] == method and len(data["paths"]) == 1
     assert set(data["objectives"]) == {"length", "smoothness_deg", "safety", "min_clearance"}
 
 
-def test_ega_is_the_default_and_its_seed_repeats(capsys):
-    code, out, _ = run(capsys, "ega07_slits1", "--json", "--seed", "4", "--max-gen", "4")
-    again = run(capsys, "ega07_slits1", "--json", "--seed", "4", "--max-gen", "4")[1]
+def test_exact_is_the_default_and_the_egas_seed_repeats(capsys):
+    assert json.loads(run(capsys, "ega07_slits1", "--json")[1])["method"] == "exact"  # as on grids: the optimum
+    code, out, _ = run(capsys, "ega07_slits1", "--method", "ega", "--json", "--seed", "4", "--max-gen", "4")
+    again = run(capsys, "ega07_slits1", "--method", "ega", "--json", "--seed", "4", "--max-gen", "4")[1]
     data = json.loads(out)
     assert code == 0 and data["method"] == "ega" and out.split('"runtime_s"')[0] == again.split('"runtime_s"')[0]
     assert data["info"]["pop_size"] == 10 and data["info"]["max_gen"] == 4
 
 
 def test_weights_normalise_radius_and_text_output(capsys, tmp_path):
-    code, out, err = run(capsys, "ega04_corridor1", "--weights", "1,0.5,0", "--path", "spline", "--max-gen", "3",
-                         "--json")
+    code, out, err = run(capsys, "ega04_corridor1", "--method", "ega", "--weights", "1,0.5,0", "--path", "spline",
+                         "--max-gen", "3", "--json")
     assert code == 0, err
     assert json.loads(out)["info"]["weights"] == [1.0, 0.5, 0.0]
-    code, out, err = run(capsys, "ega04_corridor1", "--normalise", "--max-gen", "2", "--safety", "min")
+    code, out, err = run(capsys, "ega04_corridor1", "--method", "ega", "--normalise", "--max-gen", "2", "--safety",
+                         "min")
     assert code == 0, err
     assert out.startswith("ega04_corridor1: reached (ega") and "length" in out
     code, out, err = run(capsys, "ega_cross4", "--robot-radius", "0.3", "--method", "exact", "--json",
@@ -57,32 +59,35 @@ def test_weights_normalise_radius_and_text_output(capsys, tmp_path):
 
 
 @pytest.mark.parametrize("argv, words", [
-    (["ega07_slits1", "--method", "dijkstra"], "plans grid scenarios"),
-    (["three_slit", "--method", "ega"], "plans continuous scenarios"),
+    (["ega07_slits1", "--method", "dijkstra"], "is not a method of continuous planning"),
+    (["three_slit", "--method", "ega"], "is not a method of grid-path planning"),
     (["three_slit", "--safety", "min"], "--safety applies to continuous scenarios only"),
     (["ega07_slits1", "--diagonals"], "--diagonals applies to grid scenarios only"),
     (["ega07_slits1", "--gif", "x.gif"], "--gif applies to grid scenarios only"),
     (["ega07_slits1", "--clearance", "0.5"], "--clearance applies to grid scenarios only"),
-    (["ega07_slits1", "--grid", "0"], "--grid must be"),
-    (["ega07_slits1", "--grid", "11"], "--grid must be"),
-    (["ega07_slits1", "--weights", "1,2"], "three numbers"),
-    (["ega07_slits1", "--weights", "0,0,0"], "must not all be zero"),
-    (["ega07_slits1", "--weights", "1,x,0"], "three comma-separated numbers"),
-    (["ega07_slits1", "--weights", "1,0,0", "--normalise"], "not both"),
-    (["ega07_slits1", "--method", "nsga2", "--weights", "1,0,0"], "--weights applies to --method ega"),
+    (["ega07_slits1", "--method", "ega", "--grid", "0"], "--grid must be"),
+    (["ega07_slits1", "--method", "ega", "--grid", "11"], "grid must be"),
+    (["ega07_slits1", "--method", "ega", "--weights", "1,2"], "three numbers"),
+    (["ega07_slits1", "--method", "ega", "--weights", "0,0,0"], "must not all be zero"),
+    (["ega07_slits1", "--method", "ega", "--weights", "1,x,0"], "three comma-separated numbers"),
+    (["ega07_slits1", "--method", "ega", "--weights", "1,0,0", "--normalise"], "not both"),
+    (["ega07_slits1", "--method", "nsga2", "--weights", "1,0,0"], "--weights applies to ega and ega-paper only"),
     (["ega07_slits1", "--method", "exact", "--path", "spline"], "--path applies to the GA methods"),
     (["ega07_slits1", "--method", "astar", "--seed", "1"], "--seed applies to the GA methods"),
-    (["ega07_slits1", "--method", "exact", "--grid", "0.5"], "--grid applies to --method astar"),
-    (["ega07_slits1", "--robot-radius", "Q"], "robot_radius must be"),
+    (["ega07_slits1", "--method", "exact", "--grid", "0.5"], "--grid applies to the GA methods (ega, ega-paper, "
+                                                              "nsga2), astar and pso only, not to exact"),
+    (["ega07_slits1", "--robot-radius", "Q"], "--robot-radius must be"),
     (["ega07_slits1", "--robot-radius", "3"], "(radius 3) lies outside"),
-    (["ega07_slits1", "--pop-size", "1"], "--pop-size"),
-    (["ega07_slits1", "--method", "ega", "--time-limit", "5"], "--time-limit applies to --method rrt only"),
-    (["ega07_slits1", "--method", "rrt", "--time-limit", "0"], "--time-limit (seconds) must be"),
+    (["ega07_slits1", "--method", "ega", "--pop-size", "1"], "--pop-size"),
+    (["ega07_slits1", "--method", "ega", "--time-limit", "5"], "--time-limit applies to rrt only"),
+    (["ega07_slits1", "--method", "rrt", "--time-limit", "0"], "--time-limit must be a positive"),
     (["ega07_slits1", "--method", "rrt", "--path", "spline"], "--path applies to the GA methods"),
-    (["ega07_slits1", "--method", "prm", "--pop-size", "5"], "--pop-size applies to the GA methods and pso"),
-    (["ega07_slits1", "--method", "prm", "--grid", "0.5"], "--grid applies to --method astar, pso"),
-    (["ega07_slits1", "--method", "pso", "--weights", "1,0,0"], "--weights applies to the GA methods"),
-    (["three_slit", "--method", "prm"], "plans continuous scenarios"),
+    (["ega07_slits1", "--method", "prm", "--pop-size", "5"], "--pop-size applies to the GA methods (ega, ega-paper, "
+                                                              "nsga2) and pso only, not to prm"),
+    (["ega07_slits1", "--method", "prm", "--grid", "0.5"], "--grid applies to the GA methods (ega, ega-paper, "
+                                                            "nsga2), astar and pso only, not to prm"),
+    (["ega07_slits1", "--method", "pso", "--weights", "1,0,0"], "--weights applies to ega and ega-paper only"),
+    (["three_slit", "--method", "prm"], "is not a method of grid-path planning"),
     (["three_slit", "--time-limit", "3"], "--time-limit applies to continuous scenarios only"),
 ])
 def test_bad_inputs_give_one_error_line_and_exit_2(capsys, argv, words):

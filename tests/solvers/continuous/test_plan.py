@@ -170,7 +170,8 @@ def test_robots_planned_alone_report_their_conflicts():
     assert plan.min_robot_distance == pytest.approx(0.2) and plan.conflicts == ((0, 1),)
     assert plan.safety_distance == pytest.approx(1.1)
     data = plan.as_dict()
-    assert set(data) == {"scenario", "method", "reached", "paths", "objectives", "min_robot_distance", "conflicts",
+    assert set(data) == {"scenario", "method", "success", "message", "reached", "paths", "objectives",
+                         "min_robot_distance", "conflicts",
                          "runtime_s", "info"}
     assert set(data["objectives"]) == {"length", "smoothness_deg", "safety", "min_clearance"}
 

@@ -166,7 +166,7 @@ def test_a_free_256_map_tiles_and_sequences_in_linear_memory():
         "from htetro_opt.problems import SequencingInstance\n"
         "from htetro_opt.solvers.sequencing import sequence_waypoints\n"
         "from htetro_opt.solvers.tiling import tile_workspace\n"
-        "ts = tile_workspace(Workspace(np.zeros((256, 256), dtype=bool)))\n"
+        "ts = tile_workspace(Workspace(np.zeros((256, 256), dtype=bool))).tileset\n"
         "inst = SequencingInstance.from_tileset(ts, start=1)\n"
         "r = sequence_waypoints(inst, seed=0)\n"
         "b = ts.blocks.astype(float)\n"
