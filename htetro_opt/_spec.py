@@ -34,10 +34,11 @@ from dataclasses import dataclass, field, replace
 from importlib import import_module
 from typing import Any
 
-from htetro_opt._validation import check_seed
+from htetro_opt._validation import check_int, check_real, check_seed
 from htetro_opt.errors import ParameterError
 
-__all__ = ["DEFAULT_SEED", "ORIGINS", "Method", "Option", "Problem", "TaskSpec", "seed_option"]
+__all__ = ["DEFAULT_SEED", "ORIGINS", "Method", "Option", "Problem", "TaskSpec", "callback", "choice", "integer",
+           "real", "seed_option", "shape_letters", "unchecked"]
 
 DEFAULT_SEED = 0
 """The seed of every stochastic method when none is given: the same call gives the same result."""
@@ -225,6 +226,53 @@ class Method:
             raise ParameterError(f"method {self.name!r} is run by its task's entry point, not on its own")
         module, _, attribute = self.function.partition(":")
         return getattr(import_module(module, package), attribute)
+
+
+# --- the checks the specs' options use (each a check(value, name) of htetro_opt._validation, bound) ---------
+def integer(minimum: int | None = None, maximum: int | None = None, *, none: bool = False) -> Callable:
+    """A check of an integer in ``[minimum, maximum]`` (None too with ``none``)."""
+    return lambda value, name: check_int(value, name, minimum=minimum, maximum=maximum, allow_none=none)
+
+
+def real(minimum: float | None = None, maximum: float | None = None, *, above: bool = False,
+         none: bool = False) -> Callable:
+    """A check of a finite number at least ``minimum`` (above it with ``above``), at most ``maximum``."""
+    return lambda value, name: check_real(value, name, minimum=minimum, maximum=maximum,
+                                          include_minimum=not above, allow_none=none)
+
+
+def choice(choices: Sequence[str]) -> Callable:
+    """A check of one of ``choices``."""
+    def check(value, name):
+        if not isinstance(value, str) or value not in choices:
+            raise ParameterError(f"{name} must be one of {', '.join(choices)}, got {value!r}")
+        return value
+    return check
+
+
+def unchecked(value, name):
+    """No check here: the value is checked where it is used (a simulator's commands, a tileset's name)."""
+    return value
+
+
+def callback(value, name):
+    """A ``progress(done, total, note)`` callable or None (:mod:`htetro_opt._progress`)."""
+    from htetro_opt._progress import check_progress
+
+    return check_progress(value, name)
+
+
+def shape_letters(value, name):
+    """Morphology letters (``"TZ"``, or a list of names), or None for all seven."""
+    from htetro_opt.model.robot import SHAPES
+
+    if value is None:
+        return None
+    if isinstance(value, (list, tuple)) and all(isinstance(v, str) for v in value):
+        value = "".join(value)
+    if not isinstance(value, str) or not value or any(letter not in SHAPES for letter in value):
+        raise ParameterError(f"{name} must be morphology letters of {''.join(SHAPES)} such as 'TZ', got {value!r}")
+    return value
 
 
 def seed_option(help_text: str = "random seed: the same seed gives the same result") -> Option:
@@ -432,7 +480,8 @@ class TaskSpec:
                     scope += f" ({m.name} always plans with {key} {_words(m.problem[key])})"
                 if naming == "keyword":  # a library call: the method's options, as for a typo
                     listed = ", ".join(own) or "none"
-                    raise ParameterError(f"method {m.name!r} takes no option {key!r} ({scope}): its options are {listed}")
+                    raise ParameterError(f"method {m.name!r} takes no option {key!r} ({scope}): "
+                                         f"its options are {listed}")
                 raise ParameterError(f"{scope}, not to {m.name}")
             out[key] = option.check(value, label)
         if fill:

@@ -13,7 +13,6 @@ import numpy as np
 from pymoo.core.callback import Callback
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-from htetro_opt.algorithms.names import PICKS, SELECTIONS
 from htetro_opt.errors import PlanningError
 from htetro_opt.operators.commands.survival import reaches_goal
 

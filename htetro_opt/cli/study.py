@@ -49,7 +49,8 @@ def add_parser(sub) -> None:
     p.add_argument("--time-limit", type=float,
                    help="le2018 only: cap in seconds for each method that takes one (a study file sets its own)")
     p.add_argument("--figures", action="store_true",
-                   help="cheng2019 only: also save the paper's Figs. 8b, 14 and 15 redrawn as PNGs in DIR (needs --out)")
+                   help="cheng2019 only: also save the paper's Figs. 8b, 14 and 15 redrawn as PNGs in DIR "
+                        "(needs --out)")
     add_outputs(p, json="print one JSON object instead of the summary table")
 
 

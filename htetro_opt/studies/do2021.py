@@ -54,7 +54,7 @@ import numpy as np
 
 from htetro_opt._files import write_text
 from htetro_opt._validation import check_real
-from htetro_opt.errors import HtetroError, ParameterError
+from htetro_opt.errors import ParameterError
 from htetro_opt.studies.metrics import format_mean_std, mean_std, values_of
 from htetro_opt.studies.runner import Study, StudyRun
 from htetro_opt.studies.runner import run_study as run_runner_study

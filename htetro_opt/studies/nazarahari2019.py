@@ -38,7 +38,7 @@ from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers.continuous import plan_continuous
 
 __all__ = ["MAPS", "METHODS", "PAPER_TABLE2", "PAPER_PAIRS", "PAPER_TABLE3", "PAIRS", "run_nazarahari2019",
-           "report", "write_report", "main"]
+           "report", "write_report"]
 
 MAPS = ("ega01_random1", "ega02_maze1", "ega03_home", "ega04_corridor1", "ega05_boxpile", "ega06_corridor2",
         "ega07_slits1", "ega08_slits2", "ega09_maze2", "ega10_maze3", "ega11_random2", "ega12_plankpile")

@@ -8,8 +8,8 @@ or OMPL.
 
 from __future__ import annotations
 
-from htetro_opt._spec import Method, Option, Problem, TaskSpec, seed_option
-from htetro_opt._validation import check_bool, check_int, check_real, check_time_limit
+from htetro_opt._spec import Method, Option, Problem, TaskSpec, choice, integer, real, seed_option
+from htetro_opt._validation import check_bool, check_time_limit
 from htetro_opt.errors import ParameterError, ScenarioError
 
 __all__ = ["SPEC", "PATH_KINDS", "SAFETY_KINDS", "RRT_TIME_LIMIT"]
@@ -22,14 +22,6 @@ SAFETY_KINDS = ("paper", "min")
 
 RRT_TIME_LIMIT = 120.0
 """The paper's time limit of its B-RRT, in seconds per robot."""
-
-
-def _choice(choices):
-    def check(value, name):
-        if not isinstance(value, str) or value not in choices:
-            raise ParameterError(f"{name} must be one of {', '.join(choices)}, got {value!r}")
-        return value
-    return check
 
 
 def _weights(value, name):
@@ -60,21 +52,21 @@ OPTIONS = (
     Option("robot_radius", _radius, "the robots' radius instead of the scenario's, a number or a morphology letter "
            "(the disc around that hTetro footprint, e.g. O)", metavar="R|SHAPE", stage="problem", reference=True,
            default_text="the scenario's"),
-    Option("grid", lambda v, n: check_real(v, n, minimum=0.0, include_minimum=False), "the lattice spacing (the APF "
+    Option("grid", real(0.0, above=True), "the lattice spacing (the APF "
            "lattice and the mutations' step of the GAs)", default=1.0, type=float, metavar="D"),
-    Option("path", _choice(PATH_KINDS), "straight between the path bases or a cubic spline", default="linear",
+    Option("path", choice(PATH_KINDS), "straight between the path bases or a cubic spline", default="linear",
            choices=PATH_KINDS),
     Option("weights", _weights, "W_L,W_S,W_R of eq. 6", metavar="W_L,W_S,W_R", default_text="1,0,0"),
     Option("normalise", check_bool, "weights from three single-term runs (Nazarahari et al. 2019, §5.3) instead of "
            "--weights", default=False, type=bool),
-    Option("safety", _choice(SAFETY_KINDS), "eq. 5's sum of the path bases' clearances (paper) or the smallest "
+    Option("safety", choice(SAFETY_KINDS), "eq. 5's sum of the path bases' clearances (paper) or the smallest "
            "clearance along the path (min)", default="paper", choices=SAFETY_KINDS),
-    Option("pop_size", lambda v, n: check_int(v, n, minimum=2), "population size", default=10, type=int, metavar="N"),
-    Option("max_gen", lambda v, n: check_int(v, n, minimum=0), "generations", default=20, type=int, metavar="N"),
+    Option("pop_size", integer(2), "population size", default=10, type=int, metavar="N"),
+    Option("max_gen", integer(0), "generations", default=20, type=int, metavar="N"),
     seed_option(),
-    Option("n", lambda v, n: check_int(v, n, minimum=1, allow_none=True), "the roadmap's samples", flag="",
+    Option("n", integer(1, none=True), "the roadmap's samples", flag="",
            default_text="the paper's per map"),
-    Option("radius", lambda v, n: check_real(v, n, minimum=0.0, include_minimum=False, allow_none=True),
+    Option("radius", real(0.0, above=True, none=True),
            "the roadmap's connection radius", flag="", default_text="the paper's per map"),
     Option("time_limit", check_time_limit, "seconds per robot before giving up", default=RRT_TIME_LIMIT, type=float,
            metavar="S"),

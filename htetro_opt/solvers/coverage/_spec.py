@@ -7,8 +7,8 @@ task read (see :mod:`htetro_opt._spec`). Importing it loads no networkx or scipy
 
 from __future__ import annotations
 
-from htetro_opt._spec import Method, Option, Problem, TaskSpec
-from htetro_opt._validation import check_bool, check_int, check_real, check_time_limit
+from htetro_opt._spec import Method, Option, Problem, TaskSpec, choice, integer, real
+from htetro_opt._validation import check_bool, check_int, check_time_limit
 from htetro_opt.errors import ParameterError, ScenarioError
 
 __all__ = ["SPEC", "DEFAULT_LAYERS", "ENDS", "MOPUP_ORDERS", "STARTS"]
@@ -25,14 +25,6 @@ MOPUP_ORDERS = ("sequenced", "nearest")
 STARTS = ("scenario", "auto")
 """Where a scenario's plan starts: its roadmap's first pose (and ends at its last), or the bottom-left pose
 of the first layer (a free end)."""
-
-
-def _choice(choices):
-    def check(value, name):
-        if not isinstance(value, str) or value not in choices:
-            raise ParameterError(f"{name} must be one of {', '.join(choices)}, got {value!r}")
-        return value
-    return check
 
 
 def _start(value, name):
@@ -81,17 +73,17 @@ OPTIONS = (
     Option("start", _start, "scenario: the roadmap's first pose as start and last as goal (auto when the "
            "scenario has none); auto: the bottom-left pose of the first layer, a free end", default="scenario",
            stage="problem", choices=STARTS),
-    Option("clearance", lambda v, n: check_real(v, n, minimum=0.0), "clearance δ in cells around every block",
+    Option("clearance", real(0.0), "clearance δ in cells around every block",
            default=0.0, type=float, metavar="δ"),
     Option("stripes", _stripes, "stripe width W (H // W bands, the last taking the remainder) or widths bottom up, "
            "e.g. 2,3,2", default=4, metavar="W|W1,W2,..."),
-    Option("region_columns", lambda v, n: check_int(v, n, minimum=1), "columns of a region", default=4, type=int,
+    Option("region_columns", integer(1), "columns of a region", default=4, type=int,
            metavar="N"),
-    Option("budget", lambda v, n: check_int(v, n, minimum=1), "search nodes per region before its greedy walk is "
+    Option("budget", integer(1), "search nodes per region before its greedy walk is "
            "taken", default=20_000, type=int, metavar="N"),
-    Option("ends", _choice(ENDS), "leave a stripe at its sweep's far end (sweep) or at either end (both: every "
+    Option("ends", choice(ENDS), "leave a stripe at its sweep's far end (sweep) or at either end (both: every "
            "stripe swept either way, or out and back; never costlier)", default="sweep", choices=ENDS),
-    Option("mopup", _choice(MOPUP_ORDERS), "how the cells the sweeps left are visited: re-ordered by 2-opt and "
+    Option("mopup", choice(MOPUP_ORDERS), "how the cells the sweeps left are visited: re-ordered by 2-opt and "
            "Or-opt over exact leg costs (sequenced), or nearest first", default="sequenced", choices=MOPUP_ORDERS),
     Option("memo", check_bool, "memoise region searches by their content (False gives the same plan, slower)",
            default=True, flag="", study=False),

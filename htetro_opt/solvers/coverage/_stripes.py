@@ -62,7 +62,6 @@ from htetro_opt.errors import ParameterError
 from htetro_opt.solvers.coverage._layers import LayerGraph
 from htetro_opt.solvers.coverage._rbt import Region, greedy_walk, search_inserting, search_region
 from htetro_opt.solvers.coverage._result import Coverability
-from htetro_opt.solvers.coverage._spec import ENDS, MOPUP_ORDERS
 
 __all__ = ["stripe_widths", "plan_stripes", "StripeOutcome", "shortest_path", "mop_up", "WINDOW_MARGIN", "CUT_OFFSETS"]
 

@@ -127,7 +127,6 @@ class Plan(Result):
 
     @property
     def message(self) -> str:
-        legs = len(self.leg_ends) + (0 if self.reached else 1)
         if self.reached:
             return f"reached the goal: {len(self.commands)} commands, {self.time:g} s"
         why = "the GA's final population holds no member reaching it" if self.legs else "it has no path"

@@ -6,8 +6,8 @@
 
 from __future__ import annotations
 
-from htetro_opt._spec import Method, Option, Problem, TaskSpec, seed_option
-from htetro_opt._validation import check_bool, check_int, check_real
+from htetro_opt._spec import Method, Option, Problem, TaskSpec, callback, choice, integer, real, seed_option, unchecked
+from htetro_opt._validation import check_bool, check_int
 from htetro_opt.algorithms import CONVERGENCE_MEASURES, PICKS
 from htetro_opt.errors import ParameterError, PlanningError, ScenarioError
 
@@ -29,32 +29,6 @@ GA_PATIENCE = {"best": 100, "hypervolume": 20}
 """The GAs' patience by convergence measure, when ``patience`` is not given (measured: see plan_ga)."""
 
 
-def _int(minimum: int, *, none: bool = False):
-    return lambda value, name: check_int(value, name, minimum=minimum, allow_none=none)
-
-
-def _real(minimum: float = 0.0, *, above: bool = False, none: bool = False):
-    return lambda value, name: check_real(value, name, minimum=minimum, include_minimum=not above, allow_none=none)
-
-
-def _choice(choices):
-    def check(value, name):
-        if not isinstance(value, str) or value not in choices:
-            raise ParameterError(f"{name} must be one of {', '.join(choices)}, got {value!r}")
-        return value
-    return check
-
-
-def _anything(value, name):  # checked where it is used (the simulator checks its commands and timing)
-    return value
-
-
-def _callback(value, name):
-    from htetro_opt._progress import check_progress
-
-    return check_progress(value, name)
-
-
 def _heat_weights(value, name):
     from htetro_opt.problems.heat_costs import check_heat_weights
 
@@ -73,39 +47,39 @@ def _band(value, name):
 
 
 OPTIONS = (
-    Option("clearance", _real(), "clearance δ in cells around every block", default=0.0, type=float, metavar="δ",
+    Option("clearance", real(0.0), "clearance δ in cells around every block", default=0.0, type=float, metavar="δ",
            reference=True),
     Option("diagonals", check_bool, "allow diagonal translations", default=False, type=bool, reference=True),
-    Option("commands", _anything, "the command tokens the simulator compiles (default: the method's set)",
+    Option("commands", unchecked, "the command tokens the simulator compiles (default: the method's set)",
            flag="", study=False),
-    Option("timing", _anything, "a Timing of the commands' durations", flag="", study=False),
-    Option("t0", _int(0), "commands executed before the plan starts (the clock of moving obstacles)", default=0,
+    Option("timing", unchecked, "a Timing of the commands' durations", flag="", study=False),
+    Option("t0", integer(0), "commands executed before the plan starts (the clock of moving obstacles)", default=0,
            flag="", study=False),
     # the GAs over command chromosomes (Cheng et al. 2020; pymoo's algorithms on the same problem)
-    Option("pop_size", _int(2), "population size n_pop", default=50, type=int, metavar="N"),
-    Option("max_gen", _int(1), "generations per roadmap leg at most", default=1000, type=int, metavar="N"),
-    Option("patience", _int(1, none=True), "stop a leg after this many generations without improvement once "
+    Option("pop_size", integer(2), "population size n_pop", default=50, type=int, metavar="N"),
+    Option("max_gen", integer(1), "generations per roadmap leg at most", default=1000, type=int, metavar="N"),
+    Option("patience", integer(1, none=True), "stop a leg after this many generations without improvement once "
            "its goal is reached", type=int, metavar="N",
            default_text=", ".join(f"{n} with --converge {m}" for m, n in GA_PATIENCE.items())),
-    Option("convergence", _choice(CONVERGENCE_MEASURES), "what counts as an improvement for --patience: best, a "
+    Option("convergence", choice(CONVERGENCE_MEASURES), "what counts as an improvement for --patience: best, a "
            "rise of the goal-reaching members' best f_t, f_sm, f_sf or fitness sum; hypervolume, of the best f_t "
            "or of their front's hypervolume (half the generations, a slightly smaller front)", default="best",
            flag="--converge", choices=CONVERGENCE_MEASURES),
-    Option("max_length", _int(1, none=True), "l_p,max, the initial chromosome length", type=int, metavar="L",
+    Option("max_length", integer(1, none=True), "l_p,max, the initial chromosome length", type=int, metavar="L",
            default_text="per leg, the least multiple of 100 whose time is at least 1.5 times the leg's exact "
            "minimum time, as the paper's 100 and 200 on its maps"),
     seed_option(),
-    Option("replan_window", _int(0), "windowed exact re-planning (ours): each generation a window of up to W "
+    Option("replan_window", integer(0), "windowed exact re-planning (ours): each generation a window of up to W "
            "executed commands of the fastest and of --replan-members random goal-reaching members is replaced by "
            "the minimum-time path between its ends; 0 off", type=int, metavar="W"),
-    Option("replan_members", _int(0), "random goal-reaching members re-planned each generation besides the "
+    Option("replan_members", integer(0), "random goal-reaching members re-planned each generation besides the "
            "fastest", default=3, type=int, metavar="K"),
-    Option("reach_share", lambda v, n: check_real(v, n, minimum=0.0, include_minimum=False, maximum=1.0), "cap on the goal-reaching section of the hTetro-GA's sort, a "
+    Option("reach_share", real(0.0, 1.0, above=True), "cap on the goal-reaching section of the hTetro-GA's sort, a "
            "share in (0, 1] of n_pop (ours; 1: the paper's sort)", default=1.0, type=float, metavar="S"),
-    Option("reach_patience", _int(0), "reach repair (ours): when no member has reached the goal and the best "
+    Option("reach_patience", integer(0), "reach repair (ours): when no member has reached the goal and the best "
            "goal reachability has not risen for N generations, the member nearest to the goal gets the "
            "minimum-time path to it; 0 off", type=int, metavar="N"),
-    Option("polish_window", _int(0), "balanced polish (ours): when each leg's run ends, the largest-sum "
+    Option("polish_window", integer(0), "balanced polish (ours): when each leg's run ends, the largest-sum "
            "leading-front member has windows of up to W commands re-planned exactly for the largest fitness sum; "
            "0 off", type=int, metavar="W"),
     Option("conservative", check_bool, "add the hTetro-GA's conservative offspring set (removal, rearrangement, "
@@ -113,33 +87,33 @@ OPTIONS = (
            "sets", default=False, type=bool),
     Option("seed_exact", check_bool, "put each leg's exact minimum-time plan into its initial population; the "
            "JSON then reports the gaps to the exact optimum", default=False, type=bool),
-    Option("pick", _choice(tuple(PICKS)), "the solution each leg returns: balanced, the largest sum of the four "
+    Option("pick", choice(tuple(PICKS)), "the solution each leg returns: balanced, the largest sum of the four "
            "fitnesses (the paper's multi-objective solution), or the best f_t, f_sm or f_sf", default="balanced",
            choices=tuple(PICKS)),
-    Option("sampling_weights", _anything, "λ_mc of Algorithm 1 (token → weight)", flag="", study=False),
+    Option("sampling_weights", unchecked, "λ_mc of Algorithm 1 (token → weight)", flag="", study=False),
     Option("verbose", check_bool, "print pymoo's per-generation log", default=False, flag="", study=False),
-    Option("hv_reference", _anything, "record each leg's hypervolume by generation against this point",
+    Option("hv_reference", unchecked, "record each leg's hypervolume by generation against this point",
            flag="", study=False),
-    Option("progress", _callback, "progress(done, total, note) after every generation", flag="", study=False),
+    Option("progress", callback, "progress(done, total, note) after every generation", flag="", study=False),
     # Do et al. 2021's heat-conduction planner
     Option("weights", _heat_weights, "weights of time, smoothness and safety (eq. 12)", default=(1.0, 0.0, 0.0),
            metavar="WT,WSM,WSF"),
-    Option("t_max", _real(0.0, above=True, none=True), "t_max of f_t in seconds", type=float, metavar="S",
+    Option("t_max", real(0.0, above=True, none=True), "t_max of f_t in seconds", type=float, metavar="S",
            default_text="half an O-shape boustrophedon of the empty map"),
-    Option("element", _choice(HEAT_ELEMENTS), "the field's element, bilinear q1 (the paper's) or cell-centred p0",
+    Option("element", choice(HEAT_ELEMENTS), "the field's element, bilinear q1 (the paper's) or cell-centred p0",
            default="q1", choices=HEAT_ELEMENTS),
     Option("monotone", check_bool, "drop the rule that translations never go down the temperature field",
            default=True, type=bool, flag="", off_flag="--no-monotone"),
     Option("band", _band, "search the whole pose graph (full), or a band of R cells around the field's ascent "
            "line, widened until a path is found (auto: full up to 4 million poses, else R 8)", default="auto",
            metavar="auto|full|R"),
-    Option("band_seed", _choice(BAND_SEEDS), "where the band is centred: the field's ascent line or a "
+    Option("band_seed", choice(BAND_SEEDS), "where the band is centred: the field's ascent line or a "
            "grid-distance path", default="ascent", flag="", choices=BAND_SEEDS),
-    Option("engine", _choice(HEAT_ENGINES), "the pose-graph search", default="dijkstra", flag="", choices=HEAT_ENGINES),
-    Option("field_options", _anything, "options of solve_heat_field", flag="", study=False),
+    Option("engine", choice(HEAT_ENGINES), "the pose-graph search", default="dijkstra", flag="", choices=HEAT_ENGINES),
+    Option("field_options", unchecked, "options of solve_heat_field", flag="", study=False),
     Option("keep_fields", check_bool, "keep the legs' temperature fields in the plan's info (for plots)",
            default=False, flag="", study=False),
-    Option("sensor_range", _real(0.0, above=True, none=True), "run in the true world (hidden obstacles), sensing "
+    Option("sensor_range", real(0.0, above=True, none=True), "run in the true world (hidden obstacles), sensing "
            "cells within R cells of the blocks and replanning when the plan meets a new obstacle (Do et al. "
            "2021: 6)", type=float, metavar="R", stage="problem", default_text="off: plan on the known map"),
 )

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from htetro_opt._spec import Method, Option, Problem, TaskSpec, seed_option
-from htetro_opt._validation import check_bool, check_int, check_probability, check_real, check_time_limit
+from htetro_opt._spec import Method, Option, Problem, TaskSpec, callback, choice, integer, real, seed_option, shape_letters
+from htetro_opt._validation import check_bool, check_int, check_real, check_time_limit
 from htetro_opt.errors import ParameterError
 from htetro_opt.solvers.sequencing._budgets import TIME_LIMIT_TEXT
 
@@ -45,24 +45,6 @@ waypoint coordinates, the model is invalid without them), and ``CHRISTOFIDES`` a
 
 FAST_TSP_CANDIDATES = ("auto", "nearest", "alpha")
 """fast-tsp's neighbour lists (its ``candidates``): see :func:`~htetro_opt.solvers.sequencing.solve_fast_tsp`."""
-
-
-def _int(minimum: int, *, none: bool = False):
-    return lambda value, name: check_int(value, name, minimum=minimum, allow_none=none)
-
-
-def _choice(choices):
-    def check(value, name):
-        if not isinstance(value, str) or value not in choices:
-            raise ParameterError(f"{name} must be one of {', '.join(choices)}, got {value!r}")
-        return value
-    return check
-
-
-def _callback(value, name):
-    from htetro_opt._progress import check_progress
-
-    return check_progress(value, name)
 
 
 def _label(value, name):
@@ -104,18 +86,6 @@ def _weights(value, name):
         raise ParameterError(f"{name} must be four numbers in [0, 1e6] with a positive sum, got {text!r}") from None
 
 
-def _shapes(value, name):
-    from htetro_opt.model.robot import SHAPES
-
-    if value is None:
-        return None
-    if isinstance(value, (list, tuple)) and all(isinstance(v, str) for v in value):
-        value = "".join(value)
-    if not isinstance(value, str) or not value or any(letter not in SHAPES for letter in value):
-        raise ParameterError(f"{name} must be morphology letters of {''.join(SHAPES)} such as 'TZ', got {value!r}")
-    return value
-
-
 OPTIONS = (
     # how a tileset, a scenario or a TSPLIB file is posed as an instance
     Option("start", _label, "label of the start tile or TSPLIB node, or 'free'", default=1, stage="problem",
@@ -127,40 +97,40 @@ OPTIONS = (
            default_text="closed for TSPLIB files, open for tilesets"),
     Option("weights", _weights, "tilesets: eq. 2's weights α,β,λ,γ of blocks a,b,c,d", default=(0.25,) * 4,
            metavar="A,B,C,D", stage="problem", reference=True),
-    Option("shapes", _shapes, "when TILESET is a scenario: allowed morphologies for its tiling (by tile's "
+    Option("shapes", shape_letters, "when TILESET is a scenario: allowed morphologies for its tiling (by tile's "
            "default method)", stage="problem", reference=True, default_text="all seven"),
     # the methods' own
     seed_option(),
     Option("time_limit", check_time_limit, "time budget in seconds", type=float, metavar="S",
            default_text=f"sized to the instance: {TIME_LIMIT_TEXT}"),
-    Option("progress", _callback, "progress(done, total, note) from the methods that report", flag="",
+    Option("progress", callback, "progress(done, total, note) from the methods that report", flag="",
            study=False),
-    Option("restarts", _int(0), "kicks of the iterated local search", default=0, type=int, metavar="N"),
-    Option("max_starts", _int(1), "nearest-neighbour starts tried", default=32, flag=""),
-    Option("kicks", _int(0, none=True), "kicks of the iterated local search (0: local search only)", flag="",
+    Option("restarts", integer(0), "kicks of the iterated local search", default=0, type=int, metavar="N"),
+    Option("max_starts", integer(1), "nearest-neighbour starts tried", default=32, flag=""),
+    Option("kicks", integer(0, none=True), "kicks of the iterated local search (0: local search only)", flag="",
            default_text="sized to the instance (ils_kicks)"),
-    Option("neighbours", _int(1), "size of each node's candidate list", default=ILS_NEIGHBOURS, flag=""),
-    Option("pop_size", _int(2), "population size", default=60, flag=""),
-    Option("max_gen", _int(0), "generations at most", default=2000, flag=""),
-    Option("patience", _int(1, none=True), "generations without improvement before stopping", default=200,
+    Option("neighbours", integer(1), "size of each node's candidate list", default=ILS_NEIGHBOURS, flag=""),
+    Option("pop_size", integer(2), "population size", default=60, flag=""),
+    Option("max_gen", integer(0), "generations at most", default=2000, flag=""),
+    Option("patience", integer(1, none=True), "generations without improvement before stopping", default=200,
            flag=""),
-    Option("crossover_rate", lambda v, n: check_probability(v, n), "ordered-crossover rate", default=0.8, flag=""),
-    Option("mutation_rate", lambda v, n: check_probability(v, n), "swap-mutation rate", default=0.2, flag=""),
-    Option("tournament_size", _int(1), "tournament size", default=3, flag=""),
-    Option("elite", _int(0, none=True), "individuals kept unchanged each generation", flag="",
+    Option("crossover_rate", real(0.0, 1.0), "ordered-crossover rate", default=0.8, flag=""),
+    Option("mutation_rate", real(0.0, 1.0), "swap-mutation rate", default=0.2, flag=""),
+    Option("tournament_size", integer(1), "tournament size", default=3, flag=""),
+    Option("elite", integer(0, none=True), "individuals kept unchanged each generation", flag="",
            default_text="a tenth of the population"),
-    Option("local_search_rate", lambda v, n: check_probability(v, n), "share of offspring improved by 2-opt/Or-opt",
+    Option("local_search_rate", real(0.0, 1.0), "share of offspring improved by 2-opt/Or-opt",
            default=0.25, flag=""),
-    Option("iterations", _int(1), "random restarts of the greedy search", default=10_000, flag=""),
-    Option("scale", lambda v, n: check_real(v, n, minimum=0.0, include_minimum=False, allow_none=True),
+    Option("iterations", integer(1), "random restarts of the greedy search", default=10_000, flag=""),
+    Option("scale", real(0.0, above=True, none=True),
            "multiplier turning costs into OR-Tools' integers", flag="", default_text="from the largest cost"),
-    Option("first_solution", _choice(FIRST_SOLUTIONS), "OR-Tools' first-solution strategy",
+    Option("first_solution", choice(FIRST_SOLUTIONS), "OR-Tools' first-solution strategy",
            default="PATH_CHEAPEST_ARC", flag="", choices=FIRST_SOLUTIONS),
-    Option("max_size", _int(1), "largest instance the exact solver accepts", default=EXACT_MAX_SIZE, flag=""),
-    Option("threads", _int(1), "fast-tsp's threads", default=1, flag=""),
-    Option("candidates", _choice(FAST_TSP_CANDIDATES), "fast-tsp's neighbour lists", default="auto", flag="",
+    Option("max_size", integer(1), "largest instance the exact solver accepts", default=EXACT_MAX_SIZE, flag=""),
+    Option("threads", integer(1), "fast-tsp's threads", default=1, flag=""),
+    Option("candidates", choice(FAST_TSP_CANDIDATES), "fast-tsp's neighbour lists", default="auto", flag="",
            choices=FAST_TSP_CANDIDATES),
-    Option("runs", _int(1), "LKH's independent runs, the best kept", default=1, type=int, metavar="N"),
+    Option("runs", integer(1), "LKH's independent runs, the best kept", default=1, type=int, metavar="N"),
 )
 
 _PAPER = "Le et al. 2018"

@@ -7,9 +7,9 @@ read (see :mod:`htetro_opt._spec`). Importing it loads no OR-Tools or numba.
 
 from __future__ import annotations
 
-from htetro_opt._spec import Method, Option, Problem, TaskSpec, seed_option
+from htetro_opt._spec import Method, Option, Problem, TaskSpec, seed_option, shape_letters, unchecked
 from htetro_opt._validation import check_bool, check_time_limit
-from htetro_opt.errors import ParameterError, ScenarioError
+from htetro_opt.errors import ScenarioError
 
 __all__ = ["SPEC", "DEFAULT_TIME_LIMIT"]
 
@@ -18,31 +18,14 @@ DEFAULT_TIME_LIMIT = 60.0
 untileable raises :class:`~htetro_opt.errors.TilingTimeLimitError`."""
 
 
-def _shapes(value, name):
-    """Allowed morphologies: letters (``"TZ"``) or a list of names; None for all seven."""
-    from htetro_opt.model.robot import SHAPES
-
-    if value is None:
-        return None
-    if isinstance(value, (list, tuple)) and all(isinstance(v, str) for v in value):
-        value = "".join(value)
-    if not isinstance(value, str) or not value or any(letter not in SHAPES for letter in value):
-        raise ParameterError(f"{name} must be morphology letters of {''.join(SHAPES)} such as 'TZ', got {value!r}")
-    return value
-
-
 def _weights(value, name):
     from htetro_opt.solvers.sequencing._spec import SPEC as SEQUENCING  # the one check of eq. 2's weights
 
     return SEQUENCING.options["weights"].check(value, name)
 
 
-def _anything(value, name):  # a tileset's name: checked where the tileset is made
-    return value
-
-
 OPTIONS = (
-    Option("shapes", _shapes, "allowed morphologies, e.g. TZ or O", metavar="LETTERS", default_text="all seven, IOLJZST"),
+    Option("shapes", shape_letters, "allowed morphologies, e.g. TZ or O", metavar="LETTERS", default_text="all seven, IOLJZST"),
     Option("shuffle", check_bool, "shuffle the placement order by --seed, for another tiling (default: the fixed "
            "order)", default=False, type=bool),
     seed_option("with --shuffle: its random seed"),
@@ -52,7 +35,7 @@ OPTIONS = (
            "paper's Fig. 5)", default=False, type=bool),
     Option("weights", _weights, "α, β, λ, γ of eq. 2, for Algorithm 1's choice among a symmetric tile's labellings",
            default=(0.25,) * 4, metavar="A,B,C,D"),
-    Option("name", _anything, "the tileset's name", default="", flag="", study=False),
+    Option("name", unchecked, "the tileset's name", default="", flag="", study=False),
 )
 
 _OPTIONS = ("shapes", "shuffle", "seed", "time_limit", "overlap", "weights", "name")

@@ -2,7 +2,6 @@
 search, on the paper's workspaces, and the overlapping sub-workspace option of its Fig. 5."""
 
 import re
-import sys
 import time
 
 import numpy as np
