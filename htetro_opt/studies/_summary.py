@@ -40,7 +40,8 @@ from htetro_opt.studies._study import _NAME
 from htetro_opt.studies._trial import HV_REFERENCE
 from htetro_opt.studies.metrics import format_mean_std, group_records, mean_std, values_of
 
-__all__ = ["front_metrics", "hypervolume", "markdown_summary", "rows_csv", "summarise", "write_summary"]
+__all__ = ["front_metrics", "hypervolume", "markdown_summary", "rows_csv", "summarise", "write_report",
+           "write_summary"]
 
 _METRIC_FIELDS = {
     "plan": ("reached", "time", "n_commands", "translations", "rotations", "shapeshifts", "path_length",
@@ -250,6 +251,8 @@ def _is_number(value) -> bool:
 def _cell(value) -> str:
     if value is None:
         return ""
+    if isinstance(value, (list, tuple)):  # an order, a set of weights: one cell, space-separated
+        return " ".join(_cell(v) for v in value)
     return repr(float(value)) if isinstance(value, float) else str(value)
 
 
@@ -304,6 +307,25 @@ def write_summary(summary: Sequence[Mapping[str, Any]], folder: str | os.PathLik
         raise ParameterError(f"folder must be a folder path, got {folder!r}")
     if not isinstance(name, str) or not _NAME.fullmatch(name):
         raise ParameterError(f"name must be letters, digits, '_', '.' or '-', got {name!r}")
+    markdown, table = write_report(folder, name, markdown_summary(summary), summary, what="study summary")
+    return table, markdown
+
+
+def write_report(folder: str | os.PathLike, name: str, markdown: str, rows: Sequence[Mapping[str, Any]], *,
+                 what: str = "study report") -> tuple[Path, Path]:
+    """Write a study's report: ``folder/<name>.md`` (``markdown``) and ``folder/<name>.csv`` (``rows``, by
+    :func:`rows_csv`), each atomically (no half-written file is left). Every study writes its report so.
+
+    Returns
+    -------
+    (Path, Path)
+        The Markdown and CSV files.
+
+    Raises
+    ------
+    OutputError
+        If a file cannot be written (the folder must exist).
+    """
     folder = Path(folder)
-    return (write_text(folder / f"{name}.csv", rows_csv(summary), what="study summary"),
-            write_text(folder / f"{name}.md", markdown_summary(summary), what="study summary"))
+    return (write_text(folder / f"{name}.md", markdown, what=what),
+            write_text(folder / f"{name}.csv", rows_csv(rows), what=what))

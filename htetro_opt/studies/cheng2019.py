@@ -49,9 +49,9 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from htetro_opt._files import write_text
 from htetro_opt.errors import HtetroError, ParameterError
-from htetro_opt.studies.runner import Study, StudyRun, rows_csv
+from htetro_opt.studies.runner import Study, StudyRun
+from htetro_opt.studies.runner import write_report as write_study_report
 from htetro_opt.studies.runner import run_study as run_runner_study
 
 __all__ = [
@@ -584,7 +584,4 @@ def write_report(folder: str | os.PathLike, run: StudyRun, *, figures: Mapping[s
     OutputError
         If a file cannot be written (the folder must exist).
     """
-    folder = Path(folder)
-    text = report(run, figures=figures)
-    return (write_text(folder / f"{name}.md", text, what="study report"),
-            write_text(folder / f"{name}.csv", rows_csv(report_rows(run)), what="study report"))
+    return write_study_report(folder, name, report(run, figures=figures), report_rows(run))

@@ -41,8 +41,6 @@ gives back), beside the runner's ``DIR/do2021.jsonl`` (every trial).
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import numbers
 import os
@@ -52,11 +50,11 @@ from typing import Any
 
 import numpy as np
 
-from htetro_opt._files import write_text
 from htetro_opt._validation import check_real
 from htetro_opt.errors import ParameterError
 from htetro_opt.studies.metrics import format_mean_std, mean_std, values_of
 from htetro_opt.studies.runner import Study, StudyRun
+from htetro_opt.studies.runner import write_report as write_study_report
 from htetro_opt.studies.runner import run_study as run_runner_study
 
 __all__ = [
@@ -445,16 +443,6 @@ def report_rows(run: StudyRun | None = None, *, table8: Iterable[Mapping] | None
     return rows
 
 
-def _csv(rows: Sequence[Mapping[str, Any]]) -> str:
-    columns = list(dict.fromkeys(k for r in rows for k in r))
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, columns, lineterminator="\n")
-    writer.writeheader()
-    for r in rows:
-        writer.writerow({k: " ".join(map(str, v)) if isinstance(v, list) else v for k, v in r.items()})
-    return buffer.getvalue()
-
-
 # --- Markdown ---------------------------------------------------------------------------------------
 def _fmt(value, digits: int = 3) -> str:
     return "–" if value is None else f"{value:.{digits}f}"
@@ -699,8 +687,5 @@ def write_report(folder: str | os.PathLike, run: StudyRun | None = None, *, tabl
         If a file cannot be written (the folder must exist).
     """
     table8 = None if table8 is None else list(table8)
-    folder = Path(folder)
-    text = report(run, table8=table8, fig13=fig13)
-    rows = report_rows(run, table8=table8, fig13=fig13)
-    return (write_text(folder / f"{name}.md", text, what="study report"),
-            write_text(folder / f"{name}.csv", _csv(rows), what="study report"))
+    return write_study_report(folder, name, report(run, table8=table8, fig13=fig13),
+                              report_rows(run, table8=table8, fig13=fig13))

@@ -39,15 +39,13 @@ which prints the markdown tables and, with ``--out``, writes ``DIR/le2018.md`` a
 
 from __future__ import annotations
 
-import csv
-import io
 import numbers
 import os
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from htetro_opt._files import atomic_path
+from htetro_opt._files import write_text
 from htetro_opt._validation import check_int, check_time_limit
 from htetro_opt.errors import ParameterError, TilingError
 from htetro_opt.model.coverage import simulate_coverage
@@ -58,7 +56,7 @@ from htetro_opt.solvers.sequencing._spec import SPEC as SEQUENCING
 from htetro_opt.solvers.sequencing._spec import is_tileset
 from htetro_opt.solvers.tiling import tile_workspace
 from htetro_opt.studies.metrics import format_mean_std, mean_std
-from htetro_opt.studies.runner import Study, StudyRun
+from htetro_opt.studies.runner import Study, StudyRun, rows_csv
 from htetro_opt.studies.runner import run_study as run_runner_study
 
 __all__ = [
@@ -313,17 +311,9 @@ def markdown_report(records: Iterable[dict]) -> str:
 
 
 def write_csv(records: Iterable[dict], path) -> Path:
-    """One CSV line per record (the union of their keys as columns), written atomically."""
-    records = list(records)
-    columns = list(dict.fromkeys(k for r in records for k in r))
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, columns)
-    writer.writeheader()
-    for r in records:
-        writer.writerow({k: " ".join(map(str, v)) if isinstance(v, list) else v for k, v in r.items()})
-    with atomic_path(path) as tmp:
-        tmp.write_text(buffer.getvalue(), encoding="utf-8")
-    return Path(path)
+    """One CSV line per record (the union of their keys as columns; a list, an order, space-separated),
+    written atomically."""
+    return write_text(Path(path), rows_csv(list(records)), what="study report")
 
 
 # --- on the study runner ---------------------------------------------------------------------------

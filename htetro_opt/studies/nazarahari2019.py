@@ -21,7 +21,6 @@ report; ``--out`` writes DIR/nazarahari2019.md and DIR/nazarahari2019.csv.
 
 from __future__ import annotations
 
-import csv
 import io
 import os
 import time
@@ -36,6 +35,7 @@ from htetro_opt.model.continuous import path_length
 from htetro_opt.operators.path_bases import delete_path_bases
 from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers.continuous import plan_continuous
+from htetro_opt.studies.runner import write_report as write_study_report
 
 __all__ = ["MAPS", "METHODS", "PAPER_TABLE2", "PAPER_PAIRS", "PAPER_TABLE3", "PAIRS", "run_nazarahari2019",
            "report", "write_report"]
@@ -467,18 +467,10 @@ def _normalised_section(records: list) -> str:
 
 
 def write_report(folder, run: Run) -> tuple[Path, Path]:
-    """DIR/nazarahari2019.md (the report) and DIR/nazarahari2019.csv (every Table 2 and §5.1 trial)."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    md, table = folder / "nazarahari2019.md", folder / "nazarahari2019.csv"
-    md.write_text(report(run))
-    with table.open("w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow(["part", "map", "method", "seed", "reached", "length", "smoothness", "runtime"])
-        for r in run.table2:
-            writer.writerow(["table2", r["map"], r["method"], r["seed"], r["reached"], f"{r['length']:.6f}",
-                             f"{r['smoothness']:.4f}", f"{r['runtime']:.4f}"])
-        for r in run.pairs:
-            writer.writerow(["pairs", r["map"], r["pair"], r["seed"], r["reached"], f"{r['length']:.6f}",
-                             f"{r['smoothness']:.4f}", f"{r['runtime']:.4f}"])
-    return md, table
+    """DIR/nazarahari2019.md (the report) and DIR/nazarahari2019.csv (every Table 2 and §5.1 trial), each
+    atomically (the folder must exist)."""
+    rows = [{"part": part, "map": r["map"], "method": r.get("method", r.get("pair")), "seed": r["seed"],
+             "reached": r["reached"], "length": round(r["length"], 6), "smoothness": round(r["smoothness"], 4),
+             "runtime": round(r["runtime"], 4)}
+            for part, records in (("table2", run.table2), ("pairs", run.pairs)) for r in records]
+    return write_study_report(folder, "nazarahari2019", report(run), rows)

@@ -85,7 +85,15 @@ from __future__ import annotations
 from htetro_opt.errors import StudyError, WorkerLost
 from htetro_opt.studies._execution import EXECUTORS, StudyRun, read_records, run_study
 from htetro_opt.studies._study import METRICS, TASKS, MethodEntry, Study, list_studies, load_study
-from htetro_opt.studies._summary import front_metrics, hypervolume, markdown_summary, rows_csv, summarise, write_summary
+from htetro_opt.studies._summary import (
+    front_metrics,
+    hypervolume,
+    markdown_summary,
+    rows_csv,
+    summarise,
+    write_report,
+    write_summary,
+)
 from htetro_opt.studies._trial import (
     HV_REFERENCE,
     RUNTIME_FIELDS,
@@ -123,5 +131,6 @@ __all__ = [
     "run_trial",
     "summarise",
     "trial_record",
+    "write_report",
     "write_summary",
 ]
