@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from htetro_opt._files import write_text
-from htetro_opt.errors import ParameterError
+from htetro_opt.errors import OutputError, ParameterError
 from htetro_opt.studies._study import _NAME
 from htetro_opt.studies._trial import HV_REFERENCE
 from htetro_opt.studies.metrics import format_mean_std, group_records, mean_std, values_of
@@ -324,8 +324,12 @@ def write_report(folder: str | os.PathLike, name: str, markdown: str, rows: Sequ
     Raises
     ------
     OutputError
-        If a file cannot be written (the folder must exist).
+        If the folder cannot be made or a file cannot be written.
     """
     folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise OutputError(f"cannot create the folder {str(folder)!r} for the {what}: {err.strerror or err}") from err
     return (write_text(folder / f"{name}.md", markdown, what=what),
             write_text(folder / f"{name}.csv", rows_csv(rows), what=what))
