@@ -8,6 +8,8 @@ Neither changes the search: a run stopped by either is a prefix of the same seed
 
 from __future__ import annotations
 
+import time as _time
+
 import numpy as np
 from pymoo.core.termination import Termination
 from pymoo.util.sliding_window import SlidingWindow
@@ -71,6 +73,9 @@ class FrontConvergence(Termination):
         default 1e-9 with ``"best"``, 1e-5 with ``"hypervolume"``.
     measure : {"best", "hypervolume"}, keyword-only
         See above; ``"best"`` by default.
+    deadline : float, optional, keyword-only
+        A ``time.perf_counter()`` instant past which the run stops at its next generation (a time limit;
+        the run then depends on the machine's speed, and ``res.data["time_limited"]`` says so).
 
     Attributes
     ----------
@@ -99,8 +104,9 @@ class FrontConvergence(Termination):
     """
 
     def __init__(self, max_gen: int = 1000, patience: int = 100, tolerance: float | None = None, *,
-                 measure: str = "best") -> None:
+                 measure: str = "best", deadline: float | None = None) -> None:
         super().__init__()
+        self.deadline = None if deadline is None else check_real(deadline, "deadline")
         if not isinstance(measure, str) or measure not in CONVERGENCE_MEASURES:
             raise ParameterError(f"measure must be one of {', '.join(CONVERGENCE_MEASURES)}, got {measure!r}")
         self.measure = measure
@@ -131,6 +137,9 @@ class FrontConvergence(Termination):
             self.converged = self.stall >= self.patience
             progress = max(progress, self.stall / self.patience)
         algorithm.data["converged"] = self.converged
+        if self.deadline is not None and _time.perf_counter() >= self.deadline and progress < 1.0:
+            algorithm.data["time_limited"] = True
+            return 1.0
         return min(progress, 1.0)
 
 

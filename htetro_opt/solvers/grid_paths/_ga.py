@@ -19,7 +19,7 @@ import numpy as np
 from pymoo.optimize import minimize
 
 from htetro_opt._progress import check_progress, report
-from htetro_opt._validation import check_bool, check_int, check_seed
+from htetro_opt._validation import check_bool, check_int, check_seed, check_time_limit
 from htetro_opt.algorithms import (
     CONVERGENCE_MEASURES,
     PICKS,
@@ -149,6 +149,7 @@ def plan_ga(
     conservative: bool | None = None,
     reach_patience: int | None = None,
     polish_window: int | None = None,
+    time_limit: float | None = None,
 ) -> Plan:
     """Plan through a roadmap with a command-chromosome GA, one optimisation per leg.
 
@@ -239,6 +240,11 @@ def plan_ga(
         whole path when it is no longer (:func:`~htetro_opt.operators.commands.polish_sum`). None: the
         algorithm's default, 40 for ``"htetro-ga"``, off for ``"htetro-ga-paper"``; 0 turns it off.
         Refused (unless 0) for pymoo's algorithms.
+    time_limit : float, optional, keyword-only
+        Seconds for the whole roadmap: past them each leg stops at its next generation (a leg started
+        after the limit runs its initial population). None: no limit, the run ends by ``max_gen`` and
+        ``patience`` alone and gives the same plan for the same seed on every machine; a limit that cuts
+        the run short makes it depend on the machine's speed, and ``info["time_limited"]`` says so.
 
     Returns
     -------
@@ -280,7 +286,10 @@ def plan_ga(
     reference = None if hv_reference is None else _check_reference(hv_reference)
     seed = check_seed(seed)
     verbose = check_bool(verbose, "verbose")
+    time_limit = check_time_limit(time_limit)
     began = _time.perf_counter()
+    deadline = None if time_limit is None else began + time_limit
+    time_limited = False
     sim, roadmap, ids = prepare(workspace, roadmap, commands=commands if commands is not None else SEED000_COMMANDS,
                                 timing=timing, clearance=clearance)
     # One stream per leg, spawned from one seed: legs do not share draws, and the same seed gives the same plan.
@@ -302,13 +311,14 @@ def plan_ga(
             include = [exact.commands] if exact.reached else []
         recorder = ConvergenceRecorder(leg_began, _reporter(progress, leg, len(roadmap) - 1, max_gen),
                                        hv_reference=reference)
-        termination = FrontConvergence(max_gen=max_gen, patience=patience, measure=convergence)
+        termination = FrontConvergence(max_gen=max_gen, patience=patience, measure=convergence, deadline=deadline)
         res = minimize(problem, make_algorithm(algorithm, pop_size, sampling_weights=sampling_weights,
                                                replan_window=replan_window, replan_members=replan_members,
                                                reach_share=reach_share, conservative=conservative,
                                                include=include, reach_patience=reach_patience,
                                                polish_window=polish_window),
                        termination, seed=int(leg_seeds[leg]), callback=recorder, verbose=verbose)
+        time_limited = time_limited or bool(res.data.get("time_limited", False))
         X, F = res.pop.get("X"), res.pop.get("F")
         chosen = select_solutions(F)
         front_idx = leading_front(F)
@@ -335,6 +345,7 @@ def plan_ga(
         leg_ends.append(t0)
         start = goal
     commands_all = np.concatenate(chain) if chain else np.empty(0, dtype=np.int64)
-    info = {"pick": pick, **({"exact_times": exact_times} if seed_exact else {})}
+    info = {"pick": pick, **({"exact_times": exact_times} if seed_exact else {}),
+            **({"time_limited": True} if time_limited else {})}
     return finish_plan(sim, commands_all, ids[0], method=algorithm, leg_ends=leg_ends, failed_leg=failed,
                        began=began, legs=legs, info=info)

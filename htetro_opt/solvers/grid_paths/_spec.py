@@ -7,7 +7,7 @@
 from __future__ import annotations
 
 from htetro_opt._spec import Method, Option, Problem, TaskSpec, callback, choice, integer, real, seed_option, unchecked
-from htetro_opt._validation import check_bool, check_int
+from htetro_opt._validation import check_bool, check_int, check_time_limit
 from htetro_opt.algorithms import CONVERGENCE_MEASURES, PICKS
 from htetro_opt.errors import ParameterError, PlanningError, ScenarioError
 
@@ -95,6 +95,8 @@ OPTIONS = (
     Option("hv_reference", unchecked, "record each leg's hypervolume by generation against this point",
            flag="", study=False),
     Option("progress", callback, "progress(done, total, note) after every generation", flag="", study=False),
+    Option("time_limit", check_time_limit, "seconds for the whole roadmap, past which each leg stops at its next "
+           "generation (the plan then depends on the machine's speed)", type=float, metavar="S", default_text="none"),
     # Do et al. 2021's heat-conduction planner
     Option("weights", _heat_weights, "weights of time, smoothness and safety (eq. 12)", default=(1.0, 0.0, 0.0),
            metavar="WT,WSM,WSF"),
@@ -120,7 +122,7 @@ OPTIONS = (
 
 _SIMULATOR = ("clearance", "commands", "timing")
 _GA = (*_SIMULATOR, "pop_size", "max_gen", "patience", "convergence", "max_length", "seed", "replan_window",
-       "replan_members", "seed_exact", "pick", "sampling_weights", "verbose", "hv_reference", "progress")
+       "replan_members", "seed_exact", "pick", "sampling_weights", "verbose", "hv_reference", "progress", "time_limit")
 _HTETRO_GA = (*_GA, "reach_share", "reach_patience", "polish_window")
 _PYMOO = (*_GA, "conservative")
 _GA_KIND = dict(seeded=True, family=("ga",), capabilities={"progress"}, problem={"diagonals": False},
