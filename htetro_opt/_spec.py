@@ -38,7 +38,7 @@ from htetro_opt._validation import check_int, check_real, check_seed
 from htetro_opt.errors import ParameterError
 
 __all__ = ["DEFAULT_SEED", "ORIGINS", "Method", "Option", "Problem", "TaskSpec", "callback", "choice", "integer",
-           "real", "seed_option", "shape_letters", "unchecked"]
+           "real", "seed_option", "unchecked"]
 
 DEFAULT_SEED = 0
 """The seed of every stochastic method when none is given: the same call gives the same result."""
@@ -260,19 +260,6 @@ def callback(value, name):
     from htetro_opt._progress import check_progress
 
     return check_progress(value, name)
-
-
-def shape_letters(value, name):
-    """Morphology letters (``"TZ"``, or a list of names), or None for all seven."""
-    from htetro_opt.model.robot import SHAPES
-
-    if value is None:
-        return None
-    if isinstance(value, (list, tuple)) and all(isinstance(v, str) for v in value):
-        value = "".join(value)
-    if not isinstance(value, str) or not value or any(letter not in SHAPES for letter in value):
-        raise ParameterError(f"{name} must be morphology letters of {''.join(SHAPES)} such as 'TZ', got {value!r}")
-    return value
 
 
 def seed_option(help_text: str = "random seed: the same seed gives the same result") -> Option:

@@ -12,10 +12,11 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from htetro_opt._spec import Method, Option, Problem, TaskSpec, callback, choice, integer, real, seed_option, shape_letters
+from htetro_opt._spec import Method, Option, Problem, TaskSpec, callback, choice, integer, real, seed_option
 from htetro_opt._validation import check_bool, check_int, check_real, check_time_limit
 from htetro_opt.errors import ParameterError
 from htetro_opt.solvers.sequencing._budgets import TIME_LIMIT_TEXT
+from htetro_opt.solvers.tiling._spec import shape_letters  # a scenario is tiled first: its shapes are the tiler's
 
 __all__ = ["SPEC", "is_tileset", "EXACT_AUTO_LIMIT", "EXACT_MAX_SIZE", "EXACT_TIME_LIMIT", "FAST_TSP_CANDIDATES",
            "FIRST_SOLUTIONS", "ILS_NEIGHBOURS"]

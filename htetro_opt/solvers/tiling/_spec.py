@@ -7,15 +7,28 @@ read (see :mod:`htetro_opt._spec`). Importing it loads no OR-Tools or numba.
 
 from __future__ import annotations
 
-from htetro_opt._spec import Method, Option, Problem, TaskSpec, seed_option, shape_letters, unchecked
+from htetro_opt._spec import Method, Option, Problem, TaskSpec, seed_option, unchecked
 from htetro_opt._validation import check_bool, check_time_limit
-from htetro_opt.errors import ScenarioError
+from htetro_opt.errors import ParameterError, ScenarioError
 
-__all__ = ["SPEC", "DEFAULT_TIME_LIMIT"]
+__all__ = ["SPEC", "DEFAULT_TIME_LIMIT", "shape_letters"]
 
 DEFAULT_TIME_LIMIT = 60.0
 """The tiler's time limit in seconds when none is given: past it, a map neither tiled nor proven
 untileable raises :class:`~htetro_opt.errors.TilingTimeLimitError`."""
+
+
+def shape_letters(value, name):
+    """Morphology letters (``"TZ"``, or a list of names), or None for all seven."""
+    from htetro_opt.model.robot import SHAPES
+
+    if value is None:
+        return None
+    if isinstance(value, (list, tuple)) and all(isinstance(v, str) for v in value):
+        value = "".join(value)
+    if not isinstance(value, str) or not value or any(letter not in SHAPES for letter in value):
+        raise ParameterError(f"{name} must be morphology letters of {''.join(SHAPES)} such as 'TZ', got {value!r}")
+    return value
 
 
 def _weights(value, name):

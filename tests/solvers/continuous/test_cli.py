@@ -88,7 +88,7 @@ def test_weights_normalise_radius_and_text_output(capsys, tmp_path):
                                                             "nsga2), astar and pso only, not to prm"),
     (["ega07_slits1", "--method", "pso", "--weights", "1,0,0"], "--weights applies to ega and ega-paper only"),
     (["three_slit", "--method", "prm"], "is not a method of grid-path planning"),
-    (["three_slit", "--time-limit", "3"], "--time-limit applies to continuous scenarios only"),
+    (["three_slit", "--time-limit", "3"], "--time-limit applies to the GA methods"),
 ])
 def test_bad_inputs_give_one_error_line_and_exit_2(capsys, argv, words):
     code, out, err = run(capsys, *argv)
