@@ -167,7 +167,8 @@ class Method:
         "pop_size applies to the GA methods (…) only".
     capabilities : frozenset of str
         Task-specific capabilities (sequencing: ``"asymmetric"``, ``"tours"``, ``"geometry"``,
-        ``"implicit"``; tasks that report progress: ``"progress"``).
+        ``"implicit"``, ``"timed"`` (it ends on its time budget only); tasks that report progress:
+        ``"progress"``).
     problem : mapping, optional
         Option values the method's problem always has, for the exact reference (the heat planner
         always plans with the diagonals).

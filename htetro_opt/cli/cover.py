@@ -65,5 +65,7 @@ def run(args) -> dict:
         print(f"{problem.name}: {method.name} with {','.join(plan.layers)}: {plan.action_cost} commands, {state}, "
               f"average coverage time {plan.average_coverage_time:.3f}, {plan.regions_optimal} of {plan.regions} "
               f"region searches optimal, {plan.runtime_s:.3f} s")
+        if plan.time_limited:
+            print("the time limit cut the region searches short: the plan depends on the machine's speed")
         print(",".join(plan.tokens))
     return out

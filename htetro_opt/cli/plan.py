@@ -114,7 +114,7 @@ def _grid(args, problem, plan, out: dict, shown) -> dict:
             if "gap" in out:
                 print(f"gap to the exact optimum ({out['gap']['exact']:g} s): {pick} {out['gap']['picked']:.1%}, "
                       f"fastest {out['gap']['fastest']:.1%}")
-        if plan.info.get("time_limited"):
+        if plan.time_limited:
             print("the time limit cut the run short: the plan depends on the machine's speed, not only on the seed")
         if plan.tokens:
             print(" ".join(plan.tokens))

@@ -71,6 +71,7 @@ def run(args) -> dict:
         if not args.json:
             print(f"{tsp.name}: {instance.n} nodes, {'closed tour' if instance.closed else 'open path'}, "
                   f"{result.method}, cost {record['cost']} in {result.runtime_s:.3f} s")
+            _said_time_limited(result)
             print(" ".join(str(t) for t in result.tiles))
         return out
     tileset = problem.extras["tileset"]
@@ -86,5 +87,11 @@ def run(args) -> dict:
         late(out, lambda: save_plot(shown, lambda: plot_tileset(tileset, order=result.tiles, title=title), args.plot))
     if not args.json:
         print(f"{name}: {instance.n} waypoints, {result.method}, cost {result.cost:.4f} in {result.runtime_s:.3f} s")
+        _said_time_limited(result)
         print(" ".join(str(t) for t in result.tiles))
     return out
+
+
+def _said_time_limited(result) -> None:
+    if result.time_limited:
+        print("the time limit stopped the method: the order depends on the machine's speed, not only on the seed")

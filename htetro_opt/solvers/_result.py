@@ -5,7 +5,8 @@
 :class:`~htetro_opt.solvers.sequencing.SequenceResult` and
 :class:`~htetro_opt.solvers.coverage.CoveragePlan`: each has ``method`` (the method that made it),
 ``success`` (it did what was asked: reached the goal, covered every coverable cell), ``message`` (in
-words, what was missed when it did not), ``runtime_s`` and ``info`` (the method's extras), and
+words, what was missed when it did not), ``runtime_s``, ``time_limited`` (a time limit stopped it, so
+it depends on the machine's speed) and ``info`` (the method's extras), and
 :meth:`Result.as_dict`, the JSON-ready dict that the command line's ``--json`` prints and a study
 record holds, the run's own keys beside it.
 """
@@ -42,15 +43,22 @@ class Result(ABC):
     def message(self) -> str:
         """What the result is, in words; what was missed when not :attr:`success`."""
 
+    @property
+    def time_limited(self) -> bool:
+        """A time limit, not the method's own end (generations, kicks, a proof), stopped it: the result then
+        depends on the machine's speed, not only on the seed."""
+        return bool(self.info.get("time_limited", False))
+
     @abstractmethod
     def _fields(self) -> dict:
         """The task's own fields, JSON-ready, in the order ``as_dict`` lists them."""
 
     def as_dict(self) -> dict:
-        """JSON-ready: ``method``, ``success``, ``message``, ``runtime_s``, ``info`` (every non-finite number
-        None: strict JSON has no infinity), then the task's own fields."""
+        """JSON-ready: ``method``, ``success``, ``message``, ``runtime_s``, ``time_limited``, ``info`` (every
+        non-finite number None: strict JSON has no infinity), then the task's own fields."""
         out = {"method": self.method, "success": bool(self.success), "message": self.message,
-               "runtime_s": round(float(self.runtime_s), 6), "info": jsonable(dict(self.info))}
+               "runtime_s": round(float(self.runtime_s), 6), "time_limited": bool(self.time_limited),
+               "info": jsonable(dict(self.info))}
         out.update(self._fields())
         return out
 

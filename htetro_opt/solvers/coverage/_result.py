@@ -225,7 +225,6 @@ class CoveragePlan(Result):
             "transit_commands": self.transit_commands,
             "mopup_commands": self.mopup_commands,
             "stripes_detail": [dict(d) for d in self.stripes_detail],
-            "time_limited": self.time_limited,
             "ends": self.ends,
         }
 

@@ -361,4 +361,4 @@ def solve_greedy(instance: SequencingInstance, *, iterations: int = 10000, seed=
         if time.perf_counter() - began >= time_limit:
             break
     return best_order, {"iterations": iterations, "iterations_run": done, "best_iteration": best_at,
-                        "time_limit_s": time_limit}
+                        "timed_out": done < iterations, "time_limit_s": time_limit}

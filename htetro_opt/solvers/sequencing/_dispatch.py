@@ -58,8 +58,9 @@ class SequenceResult(Result):
 
     ``method`` names the method (``"auto (exact)"`` when ``auto`` chose it); ``order`` holds
     waypoint indices, ``tiles`` the same order as tile labels; ``info`` the method's extras
-    (``optimal`` when the order is proven optimal). Every order visits every waypoint once, so
-    ``success`` is always True; ``message`` says whether the order is proven optimal.
+    (``optimal`` when the order is proven optimal); ``time_limited`` whether the clock, not the method's
+    own end, stopped it. Every order visits every waypoint once, so ``success`` is always True;
+    ``message`` says whether the order is proven optimal.
     """
 
     method: str
@@ -68,6 +69,7 @@ class SequenceResult(Result):
     cost: float
     runtime_s: float
     info: dict = field(default_factory=dict)
+    time_limited: bool = False
 
     @property
     def success(self) -> bool:
@@ -219,4 +221,15 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", **options
         if "bound" in info:  # a bound on the reduction's optimum, which exceeds the instance's by the offset
             info["bound"] = float(info["bound"] - reduction.offset)
     order = instance.check_order(order)
-    return SequenceResult(label, order, instance.tile_order(order), instance.path_cost(order), runtime, info)
+    return SequenceResult(label, order, instance.tile_order(order), instance.path_cost(order), runtime, info,
+                          _time_limited(info, capabilities))
+
+
+def _time_limited(info: dict, capabilities) -> bool:
+    """Whether the clock, not the method's own end, stopped it: a search that only ends on its time budget
+    (``"timed"``: OR-Tools' guided local search, fast-tsp), generations, kicks or iterations cut short, or an
+    optimality proof not reached in time."""
+    if "timed" in capabilities:
+        return True
+    return bool(info.get("time_limited") or info.get("timed_out") or info.get("stopped") == "time_limit"
+                or info.get("optimal") is False)

@@ -148,7 +148,7 @@ METHODS = (
            ("time_limit", "max_size"), exact=True, origin="reference", capabilities={"asymmetric"}),
     Method("ortools", "._ortools:solve_ortools", "OR-Tools routing with guided local search (the paper's baseline)",
            ("time_limit", "progress", "scale", "first_solution"), origin="baseline", paper=_PAPER,
-           capabilities={"asymmetric", "progress"}),
+           capabilities={"asymmetric", "progress", "timed"}),
     Method("local", "._local:solve_local", "nearest neighbour + 2-opt/Or-opt, iterated with --restarts",
            ("seed", "time_limit", "progress", "restarts", "max_starts"),
            seeded=lambda options: options.get("restarts", 0) > 0, capabilities={"progress"}),
@@ -166,7 +166,8 @@ METHODS = (
     Method("greedy", "._baselines:solve_greedy", "the paper's greedy search", ("seed", "time_limit", "progress",
            "iterations"), seeded=True, origin="baseline", paper=_PAPER, capabilities={"asymmetric", "progress"}),
     Method("fast-tsp", "._backends:solve_fast_tsp", "the fast-tsp package (optional, MIT; time-based, unseeded)",
-           ("time_limit", "threads", "candidates"), origin="external", requires="fast-tsp", capabilities={"tours"}),
+           ("time_limit", "threads", "candidates"), origin="external", requires="fast-tsp",
+           capabilities={"tours", "timed"}),
     Method("lkh", "._backends:solve_lkh", "LKH-3 through the elkai package (optional; non-commercial use only)",
            ("runs",), origin="external", requires="lkh", capabilities={"asymmetric", "tours"}),
 )
