@@ -308,7 +308,8 @@ def solve_greedy(instance: SequencingInstance, *, iterations: int = 10000, seed=
     order : ndarray of int64
         The cheapest path found (the earliest among equally cheap ones).
     info : dict
-        ``iterations`` (requested), ``iterations_run`` and ``best_iteration``.
+        ``iterations`` (requested), ``iterations_run``, ``best_iteration``, ``timed_out`` (the time limit
+        stopped it before its iterations) and ``time_limit_s``.
 
     Raises
     ------
@@ -334,7 +335,8 @@ def solve_greedy(instance: SequencingInstance, *, iterations: int = 10000, seed=
     n, start, cost = instance.n, instance.start, instance.cost
     if n == 1 or (n == 2 and start is not None):
         order = np.arange(n, dtype=np.int64) if start in (None, 0) else np.array([1, 0], dtype=np.int64)
-        return order, {"iterations": iterations, "iterations_run": 1, "best_iteration": 0}
+        return order, {"iterations": iterations, "iterations_run": 1, "best_iteration": 0, "timed_out": False,
+                       "time_limit_s": time_limit}
     chunk = max(1, min(_GREEDY_CELLS // n, _GREEDY_WORK // (n * n)))  # depends on n only
     best_order, best_cost, best_at, done = None, math.inf, 0, 0
     while done < iterations:
