@@ -37,8 +37,8 @@ from typing import Any
 from htetro_opt._validation import check_int, check_real, check_seed
 from htetro_opt.errors import ParameterError
 
-__all__ = ["DEFAULT_SEED", "ORIGINS", "Method", "Option", "Problem", "TaskSpec", "callback", "choice", "integer",
-           "real", "seed_option", "unchecked"]
+__all__ = ["DEFAULT_SEED", "ORIGINS", "Method", "Option", "Problem", "TaskSpec", "at_most", "bytes_text", "callback",
+           "choice", "duration_text", "integer", "real", "seed_option", "unchecked"]
 
 DEFAULT_SEED = 0
 """The seed of every stochastic method when none is given: the same call gives the same result."""
@@ -240,6 +240,35 @@ def real(minimum: float | None = None, maximum: float | None = None, *, above: b
     """A check of a finite number at least ``minimum`` (above it with ``above``), at most ``maximum``."""
     return lambda value, name: check_real(value, name, minimum=minimum, maximum=maximum,
                                           include_minimum=not above, allow_none=none)
+
+
+def at_most(check: Callable, maximum: int, why: Callable[[int], str]) -> Callable:
+    """``check``, and a value above ``maximum`` refused before any work with what it would cost (``why(value)``:
+    the memory or time it needs), so that a typo such as ``--pop-size 1000000000`` is an error, not a
+    753 GiB allocation."""
+    def bounded(value, name):
+        value = check(value, name)
+        if value is not None and value > maximum:
+            raise ParameterError(f"{name} {value:,} {why(value)}: at most {maximum:,}")
+        return value
+    return bounded
+
+
+def bytes_text(n: float) -> str:
+    """A size in words, e.g. ``"9.3 TiB"``."""
+    for unit in ("bytes", "KiB", "MiB", "GiB", "TiB"):
+        if n < 1024 or unit == "TiB":
+            return f"{n:.0f} {unit}" if unit == "bytes" else f"{n:.1f} {unit}"
+        n /= 1024
+    raise AssertionError("unreachable")  # the loop returns at TiB
+
+
+def duration_text(seconds: float) -> str:
+    """A duration in words, e.g. ``"31,710 years"``."""
+    for unit, length in (("years", 365.25 * 86400), ("days", 86400), ("hours", 3600), ("minutes", 60)):
+        if seconds >= length:
+            return f"{seconds / length:,.0f} {unit}"
+    return f"{seconds:.0f} s"
 
 
 def choice(choices: Sequence[str]) -> Callable:

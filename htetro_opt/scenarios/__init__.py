@@ -67,6 +67,9 @@ def _bundled_or_file(name_or_path: str | Path, folder: Path, suffix: str, kind: 
     path = Path(name_or_path)
     if path.is_file():
         return path
+    if path.suffix or "/" in str(name_or_path) or path.exists():  # meant as a file: say what is wrong with it
+        what = "is a folder, not a file" if path.is_dir() else "file not found"
+        raise ScenarioError(f"{kind} file {str(name_or_path)!r}: {what}")
     raise ScenarioError(f"no {kind} {str(name_or_path)!r}: not a bundled name ({', '.join(names())}) nor a file")
 
 

@@ -8,7 +8,19 @@ or OMPL.
 
 from __future__ import annotations
 
-from htetro_opt._spec import Method, Option, Problem, TaskSpec, choice, integer, real, seed_option
+from htetro_opt._spec import (
+    Method,
+    Option,
+    Problem,
+    TaskSpec,
+    at_most,
+    bytes_text,
+    choice,
+    duration_text,
+    integer,
+    real,
+    seed_option,
+)
 from htetro_opt._validation import check_bool, check_time_limit
 from htetro_opt.errors import ParameterError, ScenarioError
 
@@ -61,8 +73,11 @@ OPTIONS = (
            "--weights", default=False, type=bool),
     Option("safety", choice(SAFETY_KINDS), "eq. 5's sum of the path bases' clearances (paper) or the smallest "
            "clearance along the path (min)", default="paper", choices=SAFETY_KINDS),
-    Option("pop_size", integer(2), "population size", default=10, type=int, metavar="N"),
-    Option("max_gen", integer(0), "generations", default=20, type=int, metavar="N"),
+    Option("pop_size", at_most(integer(2), 10_000, lambda v: "would hold that many initial APF paths and their "
+                               f"path bases for every robot, about {bytes_text(v * 100_000)}"),
+           "population size", default=10, type=int, metavar="N"),
+    Option("max_gen", at_most(integer(0), 100_000, lambda v: f"generations would take {duration_text(v * 1e-2)} or "
+                              "more at ten milliseconds each"), "generations", default=20, type=int, metavar="N"),
     seed_option(),
     Option("n", integer(1, none=True), "the roadmap's samples", flag="",
            default_text="the paper's per map"),

@@ -7,7 +7,7 @@ task read (see :mod:`htetro_opt._spec`). Importing it loads no networkx or scipy
 
 from __future__ import annotations
 
-from htetro_opt._spec import Method, Option, Problem, TaskSpec, choice, integer, real
+from htetro_opt._spec import Method, Option, Problem, TaskSpec, at_most, bytes_text, choice, integer, real
 from htetro_opt._validation import check_bool, check_int, check_time_limit
 from htetro_opt.errors import ParameterError, ScenarioError
 
@@ -68,8 +68,8 @@ def _stripes(value, name):
 
 
 OPTIONS = (
-    Option("shapes", _layers, "morphology layers: O, vI, hI or SHAPE@H, comma-separated", default=",".join(DEFAULT_LAYERS),
-           stage="problem", metavar="LAYERS"),
+    Option("shapes", _layers, "morphology layers: O, vI, hI or SHAPE@H, comma-separated",
+           default=",".join(DEFAULT_LAYERS), stage="problem", metavar="LAYERS"),
     Option("start", _start, "scenario: the roadmap's first pose as start and last as goal (auto when the "
            "scenario has none); auto: the bottom-left pose of the first layer, a free end", default="scenario",
            stage="problem", choices=STARTS),
@@ -79,7 +79,8 @@ OPTIONS = (
            "e.g. 2,3,2", default=4, metavar="W|W1,W2,..."),
     Option("region_columns", integer(1), "columns of a region", default=4, type=int,
            metavar="N"),
-    Option("budget", integer(1), "search nodes per region before its greedy walk is "
+    Option("budget", at_most(integer(1), 10_000_000, lambda v: f"search nodes a region may hold in memory, about "
+                             f"{bytes_text(v * 200)}"), "search nodes per region before its greedy walk is "
            "taken", default=20_000, type=int, metavar="N"),
     Option("ends", choice(ENDS), "leave a stripe at its sweep's far end (sweep) or at either end (both: every "
            "stripe swept either way, or out and back; never costlier)", default="sweep", choices=ENDS),

@@ -6,7 +6,21 @@
 
 from __future__ import annotations
 
-from htetro_opt._spec import Method, Option, Problem, TaskSpec, callback, choice, integer, real, seed_option, unchecked
+from htetro_opt._spec import (
+    Method,
+    Option,
+    Problem,
+    TaskSpec,
+    at_most,
+    bytes_text,
+    callback,
+    choice,
+    duration_text,
+    integer,
+    real,
+    seed_option,
+    unchecked,
+)
 from htetro_opt._validation import check_bool, check_int, check_time_limit
 from htetro_opt.algorithms import CONVERGENCE_MEASURES, PICKS
 from htetro_opt.errors import ParameterError, PlanningError, ScenarioError
@@ -29,6 +43,23 @@ GA_PATIENCE = {"best": 100, "hypervolume": 20}
 """The GAs' patience by convergence measure, when ``patience`` is not given (measured: see plan_ga)."""
 
 
+MAX_POPULATION = 100_000
+"""The largest ``pop_size`` of the GAs: each member holds a chromosome of a hundred and more commands and its
+simulation, about 10 kB (1 GB at this size)."""
+
+MAX_GENERATIONS = 1_000_000
+"""The largest ``max_gen`` of the GAs: a generation takes about a millisecond or more (17 minutes a leg at this
+size), so a larger one is a mistake rather than a plan."""
+
+
+def _population(value: int) -> str:
+    return f"would hold that many chromosomes and their simulations, about {bytes_text(value * 10_000)}"
+
+
+def _generations(value: int) -> str:
+    return f"generations would take {duration_text(value * 1e-3)} or more a leg at a millisecond each"
+
+
 def _heat_weights(value, name):
     from htetro_opt.problems.heat_costs import check_heat_weights
 
@@ -43,7 +74,8 @@ def _band(value, name):
     try:
         return check_int(value, name, minimum=1)
     except ParameterError:
-        raise ParameterError(f"{name} must be auto, full or a radius in cells (an integer >= 1), got {value!r}") from None
+        raise ParameterError(f"{name} must be auto, full or a radius in cells (an integer >= 1), "
+                             f"got {value!r}") from None
 
 
 OPTIONS = (
@@ -56,8 +88,10 @@ OPTIONS = (
     Option("t0", integer(0), "commands executed before the plan starts (the clock of moving obstacles)", default=0,
            flag="", study=False),
     # the GAs over command chromosomes (Cheng et al. 2020; pymoo's algorithms on the same problem)
-    Option("pop_size", integer(2), "population size n_pop", default=50, type=int, metavar="N"),
-    Option("max_gen", integer(1), "generations per roadmap leg at most", default=1000, type=int, metavar="N"),
+    Option("pop_size", at_most(integer(2), MAX_POPULATION, _population), "population size n_pop", default=50,
+           type=int, metavar="N"),
+    Option("max_gen", at_most(integer(1), MAX_GENERATIONS, _generations), "generations per roadmap leg at most",
+           default=1000, type=int, metavar="N"),
     Option("patience", integer(1, none=True), "stop a leg after this many generations without improvement once "
            "its goal is reached", type=int, metavar="N",
            default_text=", ".join(f"{n} with --converge {m}" for m, n in GA_PATIENCE.items())),

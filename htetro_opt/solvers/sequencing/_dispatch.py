@@ -212,6 +212,10 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", **options
     if (instance.closed or instance.end is not None) and "tours" not in capabilities:
         reduction = reduce_to_open_path(instance)
         solved = reduction.instance
+    if solved is not instance and solved.n > call.get("max_size", solved.n):  # the user's count, and why it grew
+        raise ParameterError(f"the exact method proves optima of at most {call['max_size']} waypoints, this instance "
+                             f"has {instance.n} ({solved.n} as the open path a closed tour or a fixed end is solved "
+                             "as): use the ils, ortools or local method for large instances")
     began = time.perf_counter()
     order, info = function(solved, **call)
     runtime = time.perf_counter() - began

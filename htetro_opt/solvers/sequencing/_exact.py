@@ -115,7 +115,7 @@ def solve_exact(instance: SequencingInstance, *, seed=0, time_limit: float | Non
     if n > max_size:
         raise ParameterError(
             f"the exact method proves optima of at most {max_size} waypoints, this instance has {n}: "
-            "use the ortools or local method for large instances"
+            "use the ils, ortools or local method for large instances"
         )
     start = instance.start
     if n == 1:

@@ -186,8 +186,9 @@ def _pose(source, *, label, start, end, closed, weights, shapes) -> Problem:
                 raise ParameterError(f"{label(name)} does not apply to a TSPLIB file (it has no tiles)")
         closed = True if closed is None else closed
         if closed and end is not None:
-            raise ParameterError(f"{label('end')} applies to open paths: a TSPLIB file is a closed tour unless asked for "
-                                 "an open path (--open on the command line, closed=False in a call or a study)")
+            raise ParameterError(f"{label('end')} applies to open paths: a TSPLIB file is a closed tour unless "
+                                 "asked for an open path (--open on the command line, closed=False in a call or a "
+                                 "study)")
         nodes = range(1, loaded.dimension + 1)
         instance = SequencingInstance.from_matrix(loaded.cost, closed=closed,
                                                   start=_index(start, nodes, label("start"), "node"),

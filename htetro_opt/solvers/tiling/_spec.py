@@ -38,7 +38,8 @@ def _weights(value, name):
 
 
 OPTIONS = (
-    Option("shapes", shape_letters, "allowed morphologies, e.g. TZ or O", metavar="LETTERS", default_text="all seven, IOLJZST"),
+    Option("shapes", shape_letters, "allowed morphologies, e.g. TZ or O", metavar="LETTERS",
+           default_text="all seven, IOLJZST"),
     Option("shuffle", check_bool, "shuffle the placement order by --seed, for another tiling (default: the fixed "
            "order)", default=False, type=bool),
     seed_option("with --shuffle: its random seed"),
