@@ -7,15 +7,21 @@ from numba's on-disk cache) the first time it is called. The modules made of com
 (``ils``'s, the tiler's sweep), imported only when they run, take numba from :func:`require_numba`
 when they are imported. There is no pure-Python fallback: without numba these raise a
 :class:`~htetro_opt.errors.DependencyError` that says how to install it.
+
+A first compile (a fresh install, or after an upgrade) takes seconds; :func:`on_compile` lets the command
+line say so, once, rather than seem to hang.
 """
 
 from __future__ import annotations
 
 import functools
+import os
 
 from htetro_opt.errors import DependencyError
 
-__all__ = ["lazy_jit", "require_numba"]
+__all__ = ["announce_compile", "lazy_jit", "on_compile", "require_numba"]
+
+_notice = None  # the command line's: says once that kernels are being compiled (display only, never results)
 
 
 def require_numba():
@@ -52,6 +58,30 @@ def _njit(function):
     return require_numba().njit(cache=True, nogil=True)(function)
 
 
+def on_compile(notice) -> None:
+    """Have ``notice(text)`` called, once, when a kernel is about to be compiled rather than loaded from numba's
+    on-disk cache (None: say nothing, the library's default)."""
+    global _notice
+    _notice = notice
+
+
+def announce_compile(dispatcher) -> None:
+    """Call the :func:`on_compile` notice if ``dispatcher`` (a numba function) has nothing in the on-disk cache
+    yet: its first call compiles. Reads numba's cache index (a private attribute: where it is missing, nothing
+    is said)."""
+    global _notice
+    if _notice is None:
+        return
+    try:
+        cached = os.path.exists(dispatcher._cache._cache_file._index_path)
+    except AttributeError:
+        return
+    if not cached:
+        notice, _notice = _notice, None  # once a process
+        notice("compiling the numerical kernels on their first use (seconds, once: numba keeps them on disk for "
+               "the next runs)")
+
+
 def lazy_jit(function=None, *, calls: tuple[str, ...] = ()):
     """``function`` compiled by numba on its first call.
 
@@ -86,6 +116,7 @@ def lazy_jit(function=None, *, calls: tuple[str, ...] = ()):
             for name in calls:
                 function.__globals__[name] = _njit(function.__globals__[name])
             compiled = _njit(function)
+            announce_compile(compiled)
         return compiled(*args)
 
     call.py_func = function  # the Python version, for tests that compare the two

@@ -140,8 +140,14 @@ def _stderr_is_terminal() -> bool:
 
 
 def console(args) -> Console:
-    """Progress bars on stderr: on a terminal, unless ``--quiet``."""
-    return Console(enabled=not getattr(args, "quiet", False) and _stderr_is_terminal())
+    """Progress bars on stderr: on a terminal, unless ``--quiet``; there, a first compile of the kernels is
+    said too (it takes seconds once)."""
+    shown = Console(enabled=not getattr(args, "quiet", False) and _stderr_is_terminal())
+    if shown.enabled:
+        from htetro_opt._jit import on_compile
+
+        on_compile(lambda text: print(text, file=sys.stderr, flush=True))
+    return shown
 
 
 def _files_only_backend() -> None:
