@@ -37,8 +37,8 @@ from typing import Any
 from htetro_opt._validation import check_int, check_real, check_seed
 from htetro_opt.errors import ParameterError
 
-__all__ = ["DEFAULT_SEED", "ORIGINS", "Method", "Option", "Problem", "TaskSpec", "at_most", "bytes_text", "callback",
-           "choice", "duration_text", "integer", "real", "seed_option", "unchecked"]
+__all__ = ["DEFAULT_SEED", "ORIGINS", "Method", "Option", "Problem", "TaskSpec", "additions", "at_most", "bytes_text",
+           "callback", "choice", "duration_text", "integer", "real", "seed_option", "unchecked"]
 
 DEFAULT_SEED = 0
 """The seed of every stochastic method when none is given: the same call gives the same result."""
@@ -280,6 +280,23 @@ def choice(choices: Sequence[str]) -> Callable:
     return check
 
 
+def additions(names: Mapping[str, str]) -> Callable:
+    """A check of a set of additions of ours, by name (``names``: name → what it does): a collection of names,
+    or the command line's text ``"all"``, ``"none"`` or ``"a,b"``; the names returned in ``names``' order."""
+    def check(value, name):
+        if isinstance(value, str):
+            value = list(names) if value == "all" else [] if value in ("none", "") else \
+                [v.strip() for v in value.split(",") if v.strip()]
+        if not isinstance(value, (list, tuple, set, frozenset)):
+            raise ParameterError(f"{name} must be names of {', '.join(names)} (or all, none), got {value!r}")
+        unknown = [v for v in value if v not in names]
+        if unknown:
+            raise ParameterError(f"{name}: unknown addition {', '.join(map(repr, unknown))}: the additions are "
+                                 f"{', '.join(names)}")
+        return tuple(n for n in names if n in set(value))
+    return check
+
+
 def unchecked(value, name):
     """No check here: the value is checked where it is used (a simulator's commands, a tileset's name)."""
     return value
@@ -340,6 +357,10 @@ class TaskSpec:
     common : sequence of str, optional
         Options every method takes (a sequence's start tile, a plan's clearance): added to each method's
         own at registration, a method registered later included.
+    relations : callable, optional
+        ``relations(method, given, label)``: a check of the options given together (``given``, checked one
+        by one), raising a :class:`~htetro_opt.errors.ParameterError` that names them by ``label(option)``
+        (a window given for an addition that is off).
     pose : callable, optional
         ``pose(scenario, *, label, **problem_options) -> Problem``: a scenario (a loaded one, a bundled
         name or a file) as the entry point's data, ``label(option)`` naming an option in its messages; see
@@ -352,7 +373,8 @@ class TaskSpec:
     def __init__(self, name: str, *, package: str, entry: str, options: Sequence[Option], methods: Sequence[Method],
                  default: str, exact: str | None = None, aliases: Mapping[str, str] | None = None,
                  families: Mapping[str, str] | None = None, common: Sequence[str] = (),
-                 pose: Callable | None = None, solve: Callable | None = None) -> None:
+                 relations: Callable | None = None, pose: Callable | None = None,
+                 solve: Callable | None = None) -> None:
         self.name = name
         self.package = package
         self.entry = entry
@@ -369,6 +391,7 @@ class TaskSpec:
         self.families = dict(families or {})
         self.default = default
         self.exact = exact
+        self._relations = relations
         self._pose = pose
         self._solve = solve
         for alias, target in self.aliases.items():
@@ -501,6 +524,8 @@ class TaskSpec:
                                          f"its options are {listed}")
                 raise ParameterError(f"{scope}, not to {m.name}")
             out[key] = option.check(value, label)
+        if self._relations is not None:
+            self._relations(m, out, lambda option: self.label(option, naming))
         if fill:
             for name in own:
                 if name not in out:

@@ -110,7 +110,7 @@ def near(tmp_path) -> str:
 
 def test_plan_json_keys_and_optimal_time(plan_out):
     assert set(plan_out) == {"scenario", "method", "success", "message", "reached", "commands", "time", "objectives",
-                             "leg_ends", "failed_leg", "runtime_s", "time_limited", "info"}
+                             "leg_ends", "failed_leg", "runtime_s", "time_limited", "additions", "info"}
     assert plan_out["success"] is plan_out["reached"] is True
     assert plan_out["scenario"] == "room"
     assert plan_out["method"] == "dijkstra"

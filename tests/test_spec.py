@@ -219,3 +219,28 @@ def test_resume_re_runs_the_records_whose_method_changed_and_says_how_many(tmp_p
     assert second.records[0] == first.records[0]
     third = run_study(study, out=tmp_path, executor="serial", resume=True)
     assert third.stale == 1 and third.resumed == 1  # back to the first revision: the latest record is stale again
+
+
+# --- additions of ours: none in a method as published, each switchable singly ----------------------------
+def test_a_method_as_published_has_none_of_our_additions_and_ours_has_them_all():
+    for task, spec in TASKS.items():
+        if "additions" not in spec.options:
+            continue
+        names = spec.options["additions"].check("all", "additions")
+        for name, method in spec.methods.items():
+            if not method.takes("additions"):
+                continue
+            expected = () if method.origin == "paper" else names
+            assert spec.default_of(method, "additions") == expected, (task, name)
+
+
+@pytest.mark.parametrize("addition", ["repair", "shortcut", "niching", "replanning", "reach-repair", "polish"])
+def test_each_ga_addition_switches_on_alone_and_the_plan_says_so(grid, addition):
+    options = {"pop_size": 6, "max_gen": 2, "max_length": 40}
+    paper = plan_path(grid.workspace, grid.roadmap, method="htetro-ga-paper", **options)
+    ours = plan_path(grid.workspace, grid.roadmap, method="htetro-ga", **options)
+    alone = plan_path(grid.workspace, grid.roadmap, method="htetro-ga-paper", additions=[addition], **options)
+    assert paper.as_dict()["additions"] == [] and len(ours.as_dict()["additions"]) == 6
+    assert alone.as_dict()["additions"] == [addition]
+    with pytest.raises(ParameterError, match="unknown addition 'speedup'"):
+        plan_path(grid.workspace, grid.roadmap, method="htetro-ga", additions=["speedup"], **options)

@@ -131,6 +131,7 @@ def make_algorithm(
     include: Sequence = (),
     reach_patience: int | None = None,
     polish_window: int | None = None,
+    additions=None,
 ):
     """A pymoo algorithm over command chromosomes.
 
@@ -166,6 +167,10 @@ def make_algorithm(
         minimum-time path to it. None: the default (100 for ``"htetro-ga"``, off for
         ``"htetro-ga-paper"``); 0 turns it off. pymoo's algorithms have no such step: a value other
         than 0 is refused there.
+    additions : collection of str, optional
+        The hTetro-GA's additions of ours switched on, exactly (:data:`GA_ADDITIONS`' names; a window or
+        patience given for one that is off is ignored): None, the name's (``"htetro-ga"`` all,
+        ``"htetro-ga-paper"`` none, a keyword given switching one back on).
     polish_window : int, optional
         The hTetro-GA's balanced polish when a run ends (:class:`HTetroGA`,
         :func:`~htetro_opt.operators.commands.polish_sum`): W, the window of the largest-sum member's
@@ -206,6 +211,11 @@ def make_algorithm(
         if name in ("htetro-ga", "htetro-ga-paper"):
             raise ParameterError(f"conservative applies to pymoo's algorithms (nsga2, nsga3, smsemoa, agemoea), not to "
                                  f"{name!r}, which always makes the conservative offspring set")
+    if additions is not None and name in ("htetro-ga", "htetro-ga-paper"):  # exactly these, whatever the name's
+        return HTetroGA.with_additions(additions, pop_size, sampling=sampling, crossover_rate=crossover_rate,
+                                       **replan)
+    if additions is not None and tuple(additions):
+        raise ParameterError(f"additions apply to the hTetro-GA (htetro-ga, htetro-ga-paper), not to {name!r}")
     if name == "htetro-ga":
         return HTetroGA(pop_size=pop_size, sampling=sampling, crossover_rate=crossover_rate, **replan)
     if name == "htetro-ga-paper":

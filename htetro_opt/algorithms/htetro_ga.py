@@ -70,7 +70,9 @@ from pymoo.core.individual import Individual
 from pymoo.core.population import Population
 
 from htetro_opt._validation import check_bool, check_int, check_probability
+from htetro_opt.algorithms.names import GA_ADDITIONS
 from htetro_opt.algorithms.solutions import select_solutions
+from htetro_opt.errors import ParameterError
 from htetro_opt.operators.commands import (
     CommandCrossover,
     CommandDuplicateElimination,
@@ -89,7 +91,7 @@ from htetro_opt.operators.commands.polish import polish_sum
 from htetro_opt.operators.commands.replan import CommandReachRepair, CommandReplan, replan_rows
 from htetro_opt.operators.commands.shortcut import repair_shortcut_evaluate
 
-__all__ = ["HTetroGA", "trim_reached"]
+__all__ = ["HTetroGA", "check_additions", "trim_reached"]
 
 
 def trim_reached(pop: Population) -> Population:
@@ -165,6 +167,25 @@ class _Members:
             ind.evaluated.update(_EVALUATED)
             self.individuals[i] = ind
         return self.individuals[i]
+
+
+def check_additions(additions) -> tuple[str, ...]:
+    """``additions`` as names of :data:`~htetro_opt.algorithms.GA_ADDITIONS`, in its order.
+
+    Raises
+    ------
+    ParameterError
+        Naming an unknown one and the additions there are.
+    """
+    if isinstance(additions, str) or not hasattr(additions, "__iter__"):
+        raise ParameterError(f"additions must be a collection of names of {', '.join(GA_ADDITIONS)}, "
+                             f"got {additions!r}")
+    additions = set(additions)
+    unknown = sorted(map(str, additions - set(GA_ADDITIONS)))
+    if unknown:
+        raise ParameterError(f"unknown hTetro-GA addition {', '.join(map(repr, unknown))}: the additions are "
+                             f"{', '.join(GA_ADDITIONS)}")
+    return tuple(name for name in GA_ADDITIONS if name in additions)
 
 
 class HTetroGA(GeneticAlgorithm):
@@ -286,6 +307,36 @@ class HTetroGA(GeneticAlgorithm):
         self._closest, self._stalled = -np.inf, 0  # the best f_gr so far, generations since it last rose
         self.polish_window = check_int(polish_window, "polish_window", minimum=0)
         self._polished = False  # the polish runs once, when the run ends
+
+    @property
+    def additions(self) -> tuple[str, ...]:
+        """The additions of ours switched on (:data:`~htetro_opt.algorithms.GA_ADDITIONS`' names, in its order)."""
+        on = {"repair": isinstance(self.repair, CommandRepair), "shortcut": self.shortcut, "niching": self.survival.niche_size > 0,
+              "replanning": self.replan is not None, "reach-repair": self.reach_repair is not None,
+              "polish": self.polish_window > 0}
+        return tuple(name for name in GA_ADDITIONS if on[name])
+
+    @classmethod
+    def with_additions(cls, additions, pop_size: int = 50, **kwargs) -> "HTetroGA":
+        """Cheng et al. 2020's hTetro-GA with exactly ``additions`` of ours switched on (names of
+        :data:`~htetro_opt.algorithms.GA_ADDITIONS`): each one off is off whatever its parameter in ``kwargs``
+        says (``replan_window``, ``reach_patience``, ``polish_window``), each one on takes its parameter from
+        ``kwargs`` or the default. ``with_additions(())`` is :meth:`as_published`.
+
+        Raises
+        ------
+        ParameterError
+            If a name is not one of the additions.
+        """
+        additions = check_additions(additions)
+        off = {"repair": {"repair": False}, "shortcut": {"shortcut": False}, "niching": {"niche_size": 0},
+               "replanning": {"replan_window": 0}, "reach-repair": {"reach_patience": 0},
+               "polish": {"polish_window": 0}}
+        options = dict(kwargs)
+        for name, values in off.items():
+            if name not in additions:
+                options.update(values)
+        return cls(pop_size, **options)
 
     @classmethod
     def as_published(cls, pop_size: int = 50, **kwargs) -> "HTetroGA":

@@ -6,7 +6,8 @@
 :class:`~htetro_opt.solvers.coverage.CoveragePlan`: each has ``method`` (the method that made it),
 ``success`` (it did what was asked: reached the goal, covered every coverable cell), ``message`` (in
 words, what was missed when it did not), ``runtime_s``, ``time_limited`` (a time limit stopped it, so
-it depends on the machine's speed) and ``info`` (the method's extras), and
+it depends on the machine's speed), ``additions`` (the additions of ours to the paper's algorithm it ran
+with: none for a method as published) and ``info`` (the method's extras), and
 :meth:`Result.as_dict`, the JSON-ready dict that the command line's ``--json`` prints and a study
 record holds, the run's own keys beside it.
 """
@@ -49,16 +50,23 @@ class Result(ABC):
         depends on the machine's speed, not only on the seed."""
         return bool(self.info.get("time_limited", False))
 
+    @property
+    def additions(self) -> tuple[str, ...]:
+        """The additions of ours to the paper's algorithm the method ran with (none for a method as published,
+        and for a method that is not a paper's)."""
+        return tuple(self.info.get("additions", ()))
+
     @abstractmethod
     def _fields(self) -> dict:
         """The task's own fields, JSON-ready, in the order ``as_dict`` lists them."""
 
     def as_dict(self) -> dict:
-        """JSON-ready: ``method``, ``success``, ``message``, ``runtime_s``, ``time_limited``, ``info`` (every
-        non-finite number None: strict JSON has no infinity), then the task's own fields."""
+        """JSON-ready: ``method``, ``success``, ``message``, ``runtime_s``, ``time_limited``, ``additions``,
+        ``info`` (every non-finite number None: strict JSON has no infinity), then the task's own fields."""
+        info = {k: v for k, v in self.info.items() if k != "additions"}
         out = {"method": self.method, "success": bool(self.success), "message": self.message,
                "runtime_s": round(float(self.runtime_s), 6), "time_limited": bool(self.time_limited),
-               "info": jsonable(dict(self.info))}
+               "additions": list(self.additions), "info": jsonable(info)}
         out.update(self._fields())
         return out
 

@@ -372,6 +372,7 @@ def run_trial(task: str, scenario: str, method: str, parameters: Mapping[str, An
                          parameters, metrics))
     problem, result = spec.solve(scenario, method=chosen.name, naming="key", **options)
     values, solution = _RECORDS[spec.name](problem, result, chosen, parameters, metrics)
+    values["additions"] = list(result.additions)  # of ours, switched on: none for a method as published
     return trial_record(head, values, solution, result.runtime_s,
                         fingerprint=spec.fingerprint(chosen, parameters))
 

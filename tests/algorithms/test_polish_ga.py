@@ -135,8 +135,11 @@ def _study(**entry):
 
 @pytest.mark.parametrize("method", ["nsga2", "dijkstra", "heat"])
 def test_the_runner_takes_the_window_for_the_htetro_ga_only(method):
-    for ga in ("htetro-ga", "htetro-ga-paper"):
-        assert _study(method=ga, polish_window=12).methods[0].options == {"polish_window": 12}
+    assert _study(method="htetro-ga", polish_window=12).methods[0].options == {"polish_window": 12}
+    paper = _study(method="htetro-ga-paper", polish_window=12, additions=["polish"])  # the paper plus one of ours
+    assert paper.methods[0].options == {"additions": ["polish"], "polish_window": 12}
+    with pytest.raises(StudyError, match=r"methods\[0\]: polish_window sets the polish addition, which is off"):
+        _study(method="htetro-ga-paper", polish_window=12)  # as published: no polish, whatever the window
     with pytest.raises(StudyError, match=r"methods\[0\]: polish_window"):
         _study(method="htetro-ga", polish_window=-1)
     with pytest.raises(StudyError, match=rf"methods\[0\]: polish_window applies to the .* not to {method}"):

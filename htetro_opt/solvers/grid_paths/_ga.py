@@ -110,6 +110,20 @@ def _check_reference(point) -> tuple[float, ...]:
     return values
 
 
+def _additions_of(algorithm) -> tuple[str, ...]:
+    """The additions of ours an algorithm runs with: the hTetro-GA's own, or the mating steps ours add to
+    pymoo's (the conservative offspring set, the re-planning)."""
+    if hasattr(algorithm, "additions"):
+        return algorithm.additions
+    from htetro_opt.algorithms import ConservativeMating, ReplanMating
+
+    found, mating = [], algorithm.mating
+    while isinstance(mating, (ConservativeMating, ReplanMating)):
+        found.append("conservative" if isinstance(mating, ConservativeMating) else "replanning")
+        mating = mating.mating
+    return tuple(sorted(found))
+
+
 def _reporter(progress, leg: int, legs: int, max_gen: int):
     """The recorder's per-generation hook that reports to ``progress``."""
     if progress is None:
@@ -150,6 +164,7 @@ def plan_ga(
     reach_patience: int | None = None,
     polish_window: int | None = None,
     time_limit: float | None = None,
+    additions=None,
 ) -> Plan:
     """Plan through a roadmap with a command-chromosome GA, one optimisation per leg.
 
@@ -240,6 +255,12 @@ def plan_ga(
         whole path when it is no longer (:func:`~htetro_opt.operators.commands.polish_sum`). None: the
         algorithm's default, 40 for ``"htetro-ga"``, off for ``"htetro-ga-paper"``; 0 turns it off.
         Refused (unless 0) for pymoo's algorithms.
+    additions : collection of str, optional, keyword-only
+        The hTetro-GA's additions of ours switched on, exactly (names of
+        :data:`~htetro_opt.algorithms.GA_ADDITIONS`): a window or patience above is the parameter of its
+        addition, used when that one is on. None: the algorithm's own (``"htetro-ga"`` all of them,
+        ``"htetro-ga-paper"`` none); pymoo's algorithms take none. The plan's ``info["additions"]`` lists
+        those on (for pymoo's: ``conservative`` and ``replanning`` when their mating has them).
     time_limit : float, optional, keyword-only
         Seconds for the whole roadmap: past them each leg stops at its next generation (a leg started
         after the limit runs its initial population). None: no limit, the run ends by ``max_gen`` and
@@ -271,9 +292,10 @@ def plan_ga(
     >>> plan.reached, plan.time
     (True, 7.0)
     """
-    make_algorithm(algorithm, pop_size, replan_window=replan_window, replan_members=replan_members,
-                   reach_share=reach_share, conservative=conservative, reach_patience=reach_patience,
-                   polish_window=polish_window)  # validates
+    checked = make_algorithm(algorithm, pop_size, replan_window=replan_window, replan_members=replan_members,
+                             reach_share=reach_share, conservative=conservative, reach_patience=reach_patience,
+                             polish_window=polish_window, additions=additions)  # validates
+    on = _additions_of(checked)
     seed_exact = check_bool(seed_exact, "seed_exact")
     if not isinstance(pick, str) or pick not in PICKS:
         raise ParameterError(f"pick must be one of {', '.join(PICKS)}, got {pick!r}")
@@ -316,7 +338,7 @@ def plan_ga(
                                                replan_window=replan_window, replan_members=replan_members,
                                                reach_share=reach_share, conservative=conservative,
                                                include=include, reach_patience=reach_patience,
-                                               polish_window=polish_window),
+                                               polish_window=polish_window, additions=additions),
                        termination, seed=int(leg_seeds[leg]), callback=recorder, verbose=verbose)
         time_limited = time_limited or bool(res.data.get("time_limited", False))
         X, F = res.pop.get("X"), res.pop.get("F")
@@ -345,7 +367,7 @@ def plan_ga(
         leg_ends.append(t0)
         start = goal
     commands_all = np.concatenate(chain) if chain else np.empty(0, dtype=np.int64)
-    info = {"pick": pick, **({"exact_times": exact_times} if seed_exact else {}),
+    info = {"pick": pick, "additions": list(on), **({"exact_times": exact_times} if seed_exact else {}),
             **({"time_limited": True} if time_limited else {})}
     return finish_plan(sim, commands_all, ids[0], method=algorithm, leg_ends=leg_ends, failed_leg=failed,
                        began=began, legs=legs, info=info)

@@ -11,6 +11,7 @@ from htetro_opt._spec import (
     Option,
     Problem,
     TaskSpec,
+    additions,
     at_most,
     bytes_text,
     callback,
@@ -22,7 +23,7 @@ from htetro_opt._spec import (
     unchecked,
 )
 from htetro_opt._validation import check_bool, check_int, check_time_limit
-from htetro_opt.algorithms import CONVERGENCE_MEASURES, PICKS
+from htetro_opt.algorithms import CONVERGENCE_MEASURES, GA_ADDITIONS, PICKS
 from htetro_opt.errors import ParameterError, PlanningError, ScenarioError
 
 __all__ = ["SPEC", "HEAT_ELEMENTS", "HEAT_ENGINES", "BAND_SEEDS", "GA_PATIENCE"]
@@ -103,19 +104,21 @@ OPTIONS = (
            default_text="per leg, the least multiple of 100 whose time is at least 1.5 times the leg's exact "
            "minimum time, as the paper's 100 and 200 on its maps"),
     seed_option(),
+    Option("additions", additions(GA_ADDITIONS), "the hTetro-GA's additions of ours switched on: all, none, or some "
+           f"of {', '.join(GA_ADDITIONS)} (each is described in docs/papers/cheng2020.md)", metavar="NAMES"),
     Option("replan_window", integer(0), "windowed exact re-planning (ours): each generation a window of up to W "
            "executed commands of the fastest and of --replan-members random goal-reaching members is replaced by "
-           "the minimum-time path between its ends; 0 off", type=int, metavar="W"),
+           "the minimum-time path between its ends; 0 off", default=40, type=int, metavar="W"),
     Option("replan_members", integer(0), "random goal-reaching members re-planned each generation besides the "
            "fastest", default=3, type=int, metavar="K"),
     Option("reach_share", real(0.0, 1.0, above=True), "cap on the goal-reaching section of the hTetro-GA's sort, a "
            "share in (0, 1] of n_pop (ours; 1: the paper's sort)", default=1.0, type=float, metavar="S"),
     Option("reach_patience", integer(0), "reach repair (ours): when no member has reached the goal and the best "
            "goal reachability has not risen for N generations, the member nearest to the goal gets the "
-           "minimum-time path to it; 0 off", type=int, metavar="N"),
+           "minimum-time path to it; 0 off", default=100, type=int, metavar="N"),
     Option("polish_window", integer(0), "balanced polish (ours): when each leg's run ends, the largest-sum "
            "leading-front member has windows of up to W commands re-planned exactly for the largest fitness sum; "
-           "0 off", type=int, metavar="W"),
+           "0 off", default=40, type=int, metavar="W"),
     Option("conservative", check_bool, "add the hTetro-GA's conservative offspring set (removal, rearrangement, "
            "shortcut of every member) to the algorithm's mating, so that a swap compares algorithms, not operator "
            "sets", default=False, type=bool),
@@ -157,12 +160,24 @@ OPTIONS = (
 _SIMULATOR = ("clearance", "commands", "timing")
 _GA = (*_SIMULATOR, "pop_size", "max_gen", "patience", "convergence", "max_length", "seed", "replan_window",
        "replan_members", "seed_exact", "pick", "sampling_weights", "verbose", "hv_reference", "progress", "time_limit")
-_HTETRO_GA = (*_GA, "reach_share", "reach_patience", "polish_window")
+_HTETRO_GA = (*_GA, "additions", "reach_share", "reach_patience", "polish_window")
 _PYMOO = (*_GA, "conservative")
 _GA_KIND = dict(seeded=True, family=("ga",), capabilities={"progress"}, problem={"diagonals": False},
                 paper="Cheng et al. 2020")
-_OURS = {"replan_window": 40, "reach_patience": 100, "polish_window": 40}
-_OFF = {"replan_window": 0, "reach_patience": 0, "polish_window": 0}
+_OURS = {"additions": tuple(GA_ADDITIONS)}
+_OFF = {"additions": ()}  # the paper's: none of ours (their parameters keep their defaults, for a switch back on)
+_PARAMETERS = {"replanning": "replan_window", "reach-repair": "reach_patience", "polish": "polish_window"}
+
+
+def _relations(method: Method, given: dict, label) -> None:
+    """A window or patience given (and not 0) sets an addition: refused when that addition is off."""
+    if not method.takes("additions"):
+        return
+    on = given.get("additions", method.defaults.get("additions", ()))
+    for addition, option in _PARAMETERS.items():
+        if given.get(option) and addition not in on:
+            raise ParameterError(f"{label(option)} sets the {addition} addition, which is off in {method.name}: "
+                                 f"switch it on with {label('additions')} (e.g. {addition})")
 
 
 def _exact(name: str, summary: str) -> Method:
@@ -225,6 +240,6 @@ SPEC = TaskSpec(
     methods=METHODS, default="dijkstra", exact="dijkstra", aliases={"exact": "dijkstra"},
     families={"exact": "the exact methods", "ga": "the GA methods", "htetro-ga": "the hTetro-GA methods",
               "pymoo": "pymoo's algorithms", "heat": "the heat planner"},
-    common=_SIMULATOR, pose=_pose, solve=_solve,
+    common=_SIMULATOR, relations=_relations, pose=_pose, solve=_solve,
 )
 """The grid-path task (see the module docstring)."""

@@ -27,7 +27,7 @@ def test_json_keys_per_method(capsys, method, extra):
     assert code == 0, err
     data = json.loads(out)
     keys = {"scenario", "method", "success", "message", "reached", "paths", "objectives", "min_robot_distance",
-            "conflicts", "runtime_s", "time_limited", "info"}
+            "conflicts", "runtime_s", "time_limited", "additions", "info"}
     assert set(data) == keys | ({"front"} if method == "nsga2" else set())
     assert data["reached"] and data["method"] == method and len(data["paths"]) == 1
     assert set(data["objectives"]) == {"length", "smoothness_deg", "safety", "min_clearance"}

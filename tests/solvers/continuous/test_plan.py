@@ -171,7 +171,7 @@ def test_robots_planned_alone_report_their_conflicts():
     assert plan.safety_distance == pytest.approx(1.1)
     data = plan.as_dict()
     assert set(data) == {"scenario", "method", "success", "message", "reached", "paths", "objectives",
-                         "min_robot_distance", "conflicts", "runtime_s", "time_limited", "info"}
+                         "min_robot_distance", "conflicts", "runtime_s", "time_limited", "additions", "info"}
     assert set(data["objectives"]) == {"length", "smoothness_deg", "safety", "min_clearance"}
 
 
