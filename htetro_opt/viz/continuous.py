@@ -81,6 +81,28 @@ def _label(plan) -> str:
     return f"{label}: {plan.length:.2f} ({robots} not reached)"
 
 
+def _robot_width(k: int, n: int) -> float:
+    """Line width of robot k of n in one plan: the first widest, each later one (drawn on top)
+    narrower, so that where robots share a stretch (two driving one line in opposite directions)
+    every colour still shows, as nested stripes."""
+    return 1.5 + min(1.0, 3.0 / max(n - 1, 1)) * (n - 1 - k)
+
+
+def _ends(ax, scenario, *, per_robot: bool) -> None:
+    """Starts as filled dots drawn over the goals, goals as hollow stars: where robots swap places,
+    a start and another robot's goal share a point and both stay visible. ``per_robot``: each in its
+    robot's colour (a legend entry per robot gives the colours), else black."""
+    n = scenario.n_robots
+    colours = [PLAN_COLOURS[k % len(PLAN_COLOURS)] if per_robot else "black" for k in range(n)]
+    ax.scatter(scenario.goals[:, 0], scenario.goals[:, 1], marker="*", s=190, facecolors="none",
+               edgecolors=colours, linewidths=1.4, zorder=4, gid="goals")
+    ax.scatter(scenario.starts[:, 0], scenario.starts[:, 1], marker="o", s=30, c=colours, edgecolors="black",
+               linewidths=0.6, zorder=5, gid="starts")
+    ax.plot([], [], "o", color="black", markersize=5, label="start" + (" (robot's colour)" if per_robot else ""))
+    ax.plot([], [], "*", markerfacecolor="none", markeredgecolor="black", markersize=12,
+            label="goal (hollow)" + (", robot's colour" if per_robot else ""))
+
+
 def plot_continuous(scenario, plans=(), *, ax=None, title: str = "", path_bases: bool = True,
                     closest: bool = True, outline: bool = True):
     """The workspace, its obstacles and the plans' paths.
@@ -107,7 +129,12 @@ def plot_continuous(scenario, plans=(), *, ax=None, title: str = "", path_bases:
     matplotlib Figure
         The map in its own coordinates (axes labelled "x (map units)", "y (map units)") and the
         legend right of it: start, goal, and per plan its method, its total length over the robots
-        that reached their goals and those that did not (which have no line).
+        that reached their goals and those that did not (which have no line). One plan of several
+        robots draws each robot in its own colour with a legend entry of its own ("robot k: its
+        length" or "robot k: not reached"), robot 0's line widest and each later one narrower, so
+        that paths along one line stay visible. Starts are filled dots drawn over the goals' hollow
+        stars (in the robot's colour for one plan of several robots), so that where the robots swap
+        places both stay visible.
 
     Raises
     ------
@@ -124,16 +151,28 @@ def plot_continuous(scenario, plans=(), *, ax=None, title: str = "", path_bases:
     else:
         fig = ax.figure
     _workspace(ax, scenario, outline=outline)
-    ax.plot(scenario.starts[:, 0], scenario.starts[:, 1], "o", color="black", markersize=6, label="start",
-            gid="starts")
-    ax.plot(scenario.goals[:, 0], scenario.goals[:, 1], "*", color="black", markersize=10, label="goal", gid="goals")
+    per_robot = len(plans) == 1 and scenario.n_robots > 1  # one plan of several robots: a colour a robot
+    _ends(ax, scenario, per_robot=per_robot)
     for p, plan in enumerate(plans):
-        label = _label(plan)  # on the plan's first line drawn
+        label = _label(plan)  # on the plan's first line drawn (one plan of several robots: a line of its own)
+        if per_robot:
+            if any(plan.robots_reached):
+                label = label.replace(": ", ": total ", 1)
+            ax.plot([], [], linestyle="none", label=label)
+            label = None
         for k, path in enumerate(plan.paths):
+            colour = PLAN_COLOURS[(k if len(plans) == 1 else p) % len(PLAN_COLOURS)]
+            width = _robot_width(k, len(plan.paths)) if per_robot else 1.5
+            if per_robot:
+                reached = plan.robots_reached[k] and len(path)
+                robot = f"robot {k}: " + (f"{float(plan.lengths[k]):.2f}" if reached else "not reached")
+                if not len(path):
+                    ax.plot([], [], "-", color=colour, linewidth=width, label=robot)
+                    continue
+                label = robot
             if not len(path):
                 continue
-            colour = PLAN_COLOURS[(k if len(plans) == 1 else p) % len(PLAN_COLOURS)]
-            ax.plot(path[:, 0], path[:, 1], "-", color=colour, linewidth=1.5, label=label, gid=f"path-{p}-{k}")
+            ax.plot(path[:, 0], path[:, 1], "-", color=colour, linewidth=width, label=label, gid=f"path-{p}-{k}")
             label = None
             if path_bases:
                 pbs = _path_bases(plan, k, path)
@@ -151,7 +190,7 @@ def plot_continuous(scenario, plans=(), *, ax=None, title: str = "", path_bases:
             radius = max(scenario.robot_radius, 0.15)
             for spot, k in zip(spots, (a, b)):
                 colour = PLAN_COLOURS[(k if len(plans) == 1 else p) % len(PLAN_COLOURS)]
-                ax.add_patch(plt.Circle(tuple(spot), radius, facecolor=colour, alpha=0.5, edgecolor="black",
+                ax.add_patch(plt.Circle(tuple(spot), radius, facecolor=colour, alpha=0.5, edgecolor="black", zorder=3,
                                         gid=f"closest-{p}"))
             ax.plot(*np.transpose(spots), ":", color="black", linewidth=1.0,
                     label=f"closest approach {distance:.2f} (t = {t:.1f})" if p == 0 else None)

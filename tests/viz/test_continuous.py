@@ -112,3 +112,18 @@ def test_apf_potential_and_front():
         plot_continuous(sc, ["exact"])
     with pytest.raises(ParameterError, match="grid scenario"):
         plot_continuous(load_scenario("three_slit"))
+
+
+def test_one_plan_of_several_robots_has_a_legend_entry_a_robot_and_visible_ends():
+    sc = load_scenario("ega_cross4")  # the four robots swap corners: each start is another's goal
+    plan = plan_continuous(sc)
+    ax = plot_continuous(sc, plan).axes[0]
+    labels = ax.get_legend_handles_labels()[1]
+    assert [f"robot {k}: {length:.2f}" for k, length in enumerate(plan.lengths)] == [
+        label for label in labels if label.startswith("robot ")]
+    assert f"exact: total {plan.length:.2f}" in labels
+    (starts,), (goals,) = by_gid(ax, "starts"), by_gid(ax, "goals")
+    assert starts.get_zorder() > goals.get_zorder()  # the dots over the stars
+    assert not goals.get_facecolors().size or (goals.get_facecolors()[:, 3] == 0).all()  # hollow stars
+    widths = [by_gid(ax, f"path-0-{k}")[0].get_linewidth() for k in range(sc.n_robots)]
+    assert widths == sorted(widths, reverse=True) and len(set(widths)) == sc.n_robots  # coincident paths show
