@@ -21,12 +21,15 @@ from htetro_opt._validation import check_bool, check_int
 from htetro_opt.errors import HtetroError, ParameterError
 from htetro_opt.model.robot import STATE_NAMES, Pose, as_pose
 from htetro_opt.model.workspace import Workspace, check_workspace
-from htetro_opt.viz._style import _ROADMAP_COLOURS, _colour_bar, _legend, _marker_handle, _pyplot
+from htetro_opt.viz._style import _ROADMAP_COLOURS, _colour_bar, _legend, _marker_handle, _obstacle_colour, _pyplot
 from htetro_opt.viz.plot import (
     DENSE_CELL_PT,
+    _cell_keys,
     _cell_points,
     _draw_map,
     _frame,
+    _hidden_cells,
+    _squares,
     _map_figure,
     figure_format,
     plot_path,
@@ -136,6 +139,46 @@ def _check_replans(replans) -> list[Pose]:
     return poses
 
 
+def _revealed_cells(replans, hidden, cells: np.ndarray, workspace: Workspace) -> np.ndarray:
+    """The obstacle cells the drawn field knows that the map lacks: those the replans' records list as
+    ``revealed`` (hidden, then sensed), and the hidden cells without a temperature. Shape (m, 2), (x, y).
+
+    Raises
+    ------
+    ParameterError
+        If a replan's ``revealed`` is not a list of (x, y) cells.
+    """
+    listed = []
+    for i, record in enumerate(replans or ()):
+        given = record.get("revealed", ()) if isinstance(record, Mapping) else ()
+        try:
+            listed.append(np.asarray(given, dtype=np.int64).reshape(-1, 2))
+        except (TypeError, ValueError) as err:
+            raise ParameterError(f"replans[{i}]['revealed'] must be a list of (x, y) cells, "
+                                 f"got {reprlib.repr(given)}") from err
+    hidden = _hidden_cells(hidden)
+    h, w = cells.shape
+    on_map = (hidden[:, 0] >= 0) & (hidden[:, 0] < w) & (hidden[:, 1] >= 0) & (hidden[:, 1] < h)
+    hidden = hidden[on_map]
+    listed.append(hidden[np.isnan(cells[hidden[:, 1], hidden[:, 0]])])  # an obstacle of the field's map
+    found = np.unique(np.concatenate(listed), axis=0)
+    found = found[(found[:, 0] >= 0) & (found[:, 0] < w) & (found[:, 1] >= 0) & (found[:, 1] < h)]
+    return found[~workspace.occupancy[found[:, 1], found[:, 0]]]
+
+
+def _draw_revealed(ax, cells: np.ndarray) -> list:
+    """Obstacles revealed while replanning: the obstacles' grey, hatched in the replans' magenta."""
+    if not len(cells):
+        return []
+    from matplotlib.collections import PolyCollection
+    from matplotlib.patches import Patch
+
+    style = {"facecolor": _obstacle_colour(), "edgecolor": _REPLAN_COLOUR, "hatch": "xx"}
+    ax.add_collection(PolyCollection(_squares(cells), facecolors=style["facecolor"], edgecolors=_REPLAN_COLOUR,
+                                     hatch="xx", linewidths=0.8, zorder=2.2, gid="revealed obstacles"))
+    return [Patch(**style, linewidth=0.8, label=f"revealed obstacle: hidden, then sensed ({len(cells)})")]
+
+
 def _arrow_grid(cells: np.ndarray, arrows: int) -> tuple[np.ndarray, np.ndarray]:
     """Rows and columns at which to draw arrows: one cell in every ``step`` each way (the same step
     both ways, so arrows sit on a square lattice), at most ``arrows`` a side, centred on the map."""
@@ -199,16 +242,32 @@ def _draw_replans(ax, replans: list[Pose]) -> list:
 
 
 def _draw_heat(ax, field, workspace: Workspace, poses, replans: list[Pose], *, arrows: int, colorbar: bool,
-               title: str | None) -> None:
+               title: str | None, revealed: np.ndarray, hidden=None) -> None:
     plt = _pyplot()
     cells = np.asarray(field.cells, dtype=float)
     dense = _cell_points(ax, workspace.width, workspace.height) < DENSE_CELL_PT
-    handles = _draw_map(ax, workspace, None, dense=dense)  # obstacles in plot_path's grey, under the image
+    # obstacles in plot_path's grey, under the image; hidden ones the field still has a temperature on
+    # (not yet sensed when it was solved) cross-hatched over it
+    unknown = _hidden_cells(hidden)
+    if len(unknown):
+        unknown = unknown[~np.isin(_cell_keys(unknown), _cell_keys(revealed))]
+    handles = _draw_map(ax, workspace, None, dense=dense)
     cmap = plt.get_cmap(HEAT_COLORMAP).with_extremes(bad=(0.0, 0.0, 0.0, 0.0))  # no temperature: the map shows
     image = ax.imshow(np.ma.masked_invalid(cells), cmap=cmap, vmin=0.0, vmax=1.0, origin="lower",
                       interpolation="nearest", extent=(-0.5, workspace.width - 0.5, -0.5, workspace.height - 0.5),
                       zorder=1, gid="temperature")
+    handles += _draw_revealed(ax, revealed)
+    if len(unknown):
+        from matplotlib.collections import PolyCollection
+        from matplotlib.patches import Patch
+
+        ax.add_collection(PolyCollection(_squares(unknown), facecolors="none", edgecolors="black", hatch="xx",
+                                         linewidths=0.8, zorder=2.2, gid="hidden obstacles"))
+        handles.append(Patch(facecolor="none", edgecolor="black", hatch="xx",
+                             label="hidden obstacle, not sensed when this field was solved"))
     dropped = np.isnan(cells) & ~workspace.occupancy
+    if len(revealed):
+        dropped[revealed[:, 1], revealed[:, 0]] = False
     if dropped.any():
         from matplotlib.patches import Patch
 
@@ -230,7 +289,7 @@ def _draw_heat(ax, field, workspace: Workspace, poses, replans: list[Pose], *, a
 
 
 def plot_heat_field(field, *, workspace: Workspace | None = None, poses=None, replans=None, arrows: int = 40,
-                    ax=None, colorbar: bool = True, title: str | None = None):
+                    ax=None, colorbar: bool = True, title: str | None = None, hidden=None):
     """Draw a temperature field, its gradient and a path: panel (b) of Do et al. 2021's Figs. 7–12.
 
     Drawn, with a legend under the map: the cell temperatures as an image (the :data:`HEAT_COLORMAP`
@@ -239,7 +298,10 @@ def plot_heat_field(field, *, workspace: Workspace | None = None, poses=None, re
     the start and the goal) white; ∇T as unit arrows (the direction in which the temperature rises,
     which a heat plan climbs) at a square lattice of cells, at most ``arrows`` a side; B2's path as a
     white line outlined in black, with a green dot at its start and a red star at its end; replanning
-    poses as magenta crosses. y grows upwards (MODEL.md §1).
+    poses as magenta crosses; obstacles revealed while replanning (hidden obstacles that the field's map
+    has, as the replans' ``revealed`` cells and the ``hidden`` cells without a temperature) in the
+    obstacles' grey hatched magenta, and hidden obstacles the field does not know cross-hatched black.
+    y grows upwards (MODEL.md §1).
 
     Parameters
     ----------
@@ -253,7 +315,8 @@ def plot_heat_field(field, *, workspace: Workspace | None = None, poses=None, re
         (x, y, state, heading) of the poses visited, as a plan's ``poses``.
     replans : sequence of mapping, optional, keyword-only
         Records with a ``"pose"`` entry, as a :class:`~htetro_opt.solvers.grid_paths.HeatRun`'s
-        ``replans``: a Pose, a ``{x, y, shape, heading}`` mapping or an (x, y, state, heading) row.
+        ``replans``: a Pose, a ``{x, y, shape, heading}`` mapping or an (x, y, state, heading) row,
+        and optionally ``"revealed"``, the obstacle cells (x, y) sensed before that replan.
     arrows : int ≥ 0, keyword-only
         Most arrows along each side of the map (0: none).
     ax : matplotlib Axes, optional, keyword-only
@@ -262,6 +325,9 @@ def plot_heat_field(field, *, workspace: Workspace | None = None, poses=None, re
         Add a colour bar beside ``ax``.
     title : str, optional, keyword-only
         Drawn as given; None gives "temperature field T and ∇T", "" no title.
+    hidden : ndarray, shape (m, 2), optional, keyword-only
+        The scenario's hidden obstacles (x, y): those without a temperature were sensed before the
+        field was solved (drawn as revealed), the others are drawn cross-hatched.
 
     Returns
     -------
@@ -289,13 +355,15 @@ def plot_heat_field(field, *, workspace: Workspace | None = None, poses=None, re
     cells = np.asarray(field.cells, dtype=float)
     workspace = _check_map(workspace, cells)
     poses = _check_poses(poses, workspace)
-    replans = _check_replans(replans)
+    replan_poses = _check_replans(replans)
     arrows = check_int(arrows, "arrows", minimum=0)
     colorbar = check_bool(colorbar, "colorbar")
     if title is not None and not isinstance(title, str):
         raise ParameterError(f"title must be a string or None, got {reprlib.repr(title)}")
+    revealed = _revealed_cells(replans, hidden, cells, workspace)
     _, ax = _map_figure(workspace, ax)
-    _draw_heat(ax, field, workspace, poses, replans, arrows=arrows, colorbar=colorbar, title=title)
+    _draw_heat(ax, field, workspace, poses, replan_poses, arrows=arrows, colorbar=colorbar, title=title,
+               revealed=revealed, hidden=hidden)
     return ax
 
 
@@ -305,7 +373,7 @@ def plot_heat_plan(workspace: Workspace, plan, field, *, replans=None, roadmap=(
 
     Left, :func:`~htetro_opt.viz.plot_path` of the plan (footprints by shape, B2's path, the roadmap's
     poses, hidden obstacles); right, :func:`plot_heat_field` of the (last) field with B2's path; the
-    poses the robot replanned from are marked on both. Do et al. 2021's Figs. 7–12, panels (a) and (b)
+    poses the robot replanned from and the obstacles revealed while replanning are marked on both. Do et al. 2021's Figs. 7–12, panels (a) and (b)
     (for one plan), and Fig. 13 with ``replans``.
 
     Parameters
@@ -348,6 +416,7 @@ def plot_heat_plan(workspace: Workspace, plan, field, *, replans=None, roadmap=(
                              f"{reprlib.repr(plan)}")
     poses = _check_poses(plan.poses, workspace, "plan.poses")
     replan_poses = _check_replans(replans)
+    revealed = _revealed_cells(replans, hidden, np.asarray(field.cells, dtype=float), workspace)
     arrows = check_int(arrows, "arrows", minimum=0)
     if not isinstance(title, str):
         raise ParameterError(f"title must be a string, got {reprlib.repr(title)}")
@@ -359,12 +428,17 @@ def plot_heat_plan(workspace: Workspace, plan, field, *, replans=None, roadmap=(
     aspect = workspace.height / workspace.width
     fig, (ax_path, ax_heat) = plt.subplots(1, 2, figsize=(15.0, max(3.5, 6.0 * aspect) + 2.0), layout="compressed")
     plot_path(workspace, poses, roadmap=roadmap, hidden=hidden, title="footprints along the plan", ax=ax_path)
-    if replan_poses:  # plot_path's legend is made: redo it with the replans' entry
+    if replan_poses or len(revealed):  # plot_path's legend is made: redo it with the replans' entries
         handles = ax_path.get_legend().legend_handles
-        handles = [h for h in handles if h is not None] + _draw_replans(ax_path, replan_poses)
+        handles = [h for h in handles if h is not None]
+        unknown = _hidden_cells(hidden)
+        if len(revealed) and np.isin(_cell_keys(unknown), _cell_keys(revealed)).all():  # none left unknown
+            handles = [h for h in handles if not h.get_label().startswith("hidden obstacle")]
+        handles += _draw_revealed(ax_path, revealed) + _draw_replans(ax_path, replan_poses)
         ax_path.get_legend().remove()
         _legend(ax_path, handles)
-    _draw_heat(ax_heat, field, workspace, poses, replan_poses, arrows=arrows, colorbar=True, title=None)
+    _draw_heat(ax_heat, field, workspace, poses, replan_poses, arrows=arrows, colorbar=True, title=None,
+               revealed=revealed, hidden=hidden)
     if title:
         fig.suptitle(title, fontsize=11)
     if path is not None:

@@ -233,3 +233,25 @@ def test_heat_plan_refuses_a_plan_without_poses(h_shape, plan, match):
     scenario, _, field = h_shape
     with pytest.raises(ParameterError, match=match):
         plot_heat_plan(scenario.workspace, plan, field)
+
+
+def test_obstacles_revealed_while_replanning_are_drawn_as_such_not_as_free_cells():
+    from htetro_opt.solvers.grid_paths import replan_heat
+
+    scenario = load_scenario("maze_partial")  # its two hidden cells are sensed, and the robot replans
+    run = replan_heat(scenario, sensor_range=6.0, keep_fields=True)
+    revealed = sorted(tuple(c) for r in run.replans for c in r["revealed"])
+    assert revealed == sorted(map(tuple, scenario.hidden.tolist()))
+    fig = plot_heat_plan(scenario.workspace, run, run.fields, replans=run.as_dict()["replans"],
+                         roadmap=scenario.roadmap, hidden=scenario.hidden)
+    ax_path, ax_heat = fig.axes[:2]
+    for ax in (ax_path, ax_heat):
+        (cells,) = [a for a in ax.collections if a.get_gid() == "revealed obstacles"]
+        centres = sorted(tuple(np.asarray(p.vertices[:4]).mean(axis=0).round().astype(int)) for p in cells.get_paths())
+        assert centres == revealed
+        assert f"revealed obstacle: hidden, then sensed ({len(revealed)})" in legend_labels(ax)
+    assert not [label for label in legend_labels(ax_heat) if label.startswith("free")]  # they are not free
+    assert not [label for label in legend_labels(ax_path) if label.startswith("hidden obstacle")]  # all sensed
+    # without the replans' records, the hidden cells the field has no temperature on are the revealed ones
+    ax = plot_heat_field(run.fields, workspace=scenario.workspace, hidden=scenario.hidden, arrows=0)
+    assert "revealed obstacles" in gids(ax)
