@@ -19,6 +19,7 @@ __all__ = ["plot_tileset", "plot_coverage"]
 _OBSTACLE_COLOUR = "#333333"
 _UNKNOWN_COLOUR = "#bbbbbb"
 _ORDER_COLOUR = "#c0392b"
+_ORDER_ALPHA = 0.7  # the order is not a driven path: lighter than what is on the map
 _CHAR_WIDTH = 0.6  # a digit's width in DejaVu Sans, as a share of the font size
 _MIN_FONT = 5.0  # pt: smaller labels are noise, not information
 _MOST_VISIT_NUMBERS = 40
@@ -70,15 +71,17 @@ def plot_tileset(tileset: Tileset, order=None, *, title: str = "", ax=None):
     """Draw a labelled tileset and, optionally, a visiting order (Le et al. 2018, Figs. 13–14).
 
     Tiles are filled with their morphology's colour (:data:`SHAPE_COLOURS`; one image, darker where
-    tiles overlap), tile borders are drawn thick and obstacles dark. With an order, the path joins
-    consecutive tiles' block-b cells (B2, the robot's reference) and carries visit numbers (the start
-    in green).
+    tiles overlap), tile borders are drawn thick and obstacles dark. With an order, dashed straight
+    segments join consecutive tiles' block-b cells (B2, the robot's reference) and carry visit numbers
+    (the start in green). A segment is the order between two tiles as the sequencing cost (eq. 2)
+    prices it, a straight displacement: not the path the robot drives, which a sequence does not
+    plan, so it is drawn dashed and lighter, and the legend says so (it may cross an obstacle).
 
     How much is written depends on how large a cell is on the figure, so that a large tileset stays
     readable: each cell carries its labels (``12b``: block b of tile 12) only when the longest label
     fits in a cell at 5 pt or more (on a 9-inch figure, up to about 40 × 40 cells); each visit gets
-    a circled number and an arrow to the next one when its number fits likewise, otherwise the order
-    is a line through the block-b cells with a number at visits 1, k, 2k, … and the last, k being the
+    a circled number and a dashed arrow to the next one when its number fits likewise, otherwise the
+    order is a dashed line through the block-b cells with a number at visits 1, k, 2k, … and the last, k being the
     smallest of 1, 2, 5, 10, 20, 50, … that writes at most 40 numbers. The 64 × 64 tiling (1004
     tiles) thus gets tile colours, borders, the path and 22 numbers, and draws and saves in about half a second.
 
@@ -173,8 +176,13 @@ def _draw_cell_labels(ax, tileset: Tileset, font: float, *, shifted: bool) -> No
 
 
 def _draw_order(ax, refs: np.ndarray, cell_pt: float) -> list:
-    """The visiting order through block-b cells ``refs`` (n, 2): arrows and every number when they
-    fit in a cell, else a line and every k-th number. Returns the legend handles."""
+    """The visiting order through block-b cells ``refs`` (n, 2): dashed arrows and every number when
+    they fit in a cell, else a dashed line and every k-th number. Returns the legend handles.
+
+    A segment is the order from one tile to the next as the eq.-2 cost prices it, a straight line
+    between block-b cells: not the path the robot drives (which a sequence does not plan), so it is
+    drawn dashed and lighter, and may cross an obstacle."""
+    from matplotlib.collections import LineCollection, PolyCollection
     from matplotlib.lines import Line2D
 
     refs = refs.astype(float)
@@ -182,30 +190,38 @@ def _draw_order(ax, refs: np.ndarray, cell_pt: float) -> list:
     font = _label_font(cell_pt, len(str(n)) + 1)
     every = font >= _MIN_FONT
     step = 1 if every else _visit_step(n)
+    dashes = (0, (4, 2.5))
     if every:
         tail, head = refs[:-1], refs[1:]
         gap = head - tail
         length = np.hypot(gap[:, 0], gap[:, 1])
-        keep = length > 0
+        keep = length > 0.6
         unit = gap[keep] / length[keep, None]
-        ax.quiver(tail[keep, 0] + 0.3 * unit[:, 0], tail[keep, 1] + 0.3 * unit[:, 1],
-                  gap[keep, 0] - 0.6 * unit[:, 0], gap[keep, 1] - 0.6 * unit[:, 1], angles="xy",
-                  scale_units="xy", scale=1, color=_ORDER_COLOUR, width=0.004, headwidth=4, headlength=5,
-                  headaxislength=4.5, zorder=4)
+        normal = unit[:, ::-1] * (-1, 1)
+        tip = head[keep] - 0.3 * unit
+        base = tip - 0.28 * unit
+        segments = np.stack([tail[keep] + 0.3 * unit, base], axis=1)
+        ax.add_collection(LineCollection(segments, colors=_ORDER_COLOUR, linewidths=1.2, linestyles=[dashes],
+                                         alpha=_ORDER_ALPHA, zorder=4, gid="order"))
+        heads = np.stack([tip, base + 0.12 * normal, base - 0.12 * normal], axis=1)
+        ax.add_collection(PolyCollection(heads, facecolors=_ORDER_COLOUR, edgecolors="none", alpha=_ORDER_ALPHA,
+                                         zorder=4, gid="order heads"))
         numbered = np.arange(n)
-        label = "visiting order, block b to block b"
     else:
-        ax.plot(refs[:, 0], refs[:, 1], color=_ORDER_COLOUR, linewidth=0.9, marker=".", markersize=2, zorder=4)
+        ax.plot(refs[:, 0], refs[:, 1], color=_ORDER_COLOUR, linewidth=0.9, linestyle=dashes, alpha=_ORDER_ALPHA,
+                marker=".", markersize=2, zorder=4, gid="order")
         numbered = np.unique(np.r_[0, np.arange(step - 1, n, step), n - 1])
         font = max(_MIN_FONT, min(8.0, font * 1.6))
-        label = "visiting order, block b to block b (dots)"
+    label = ("visiting order, block b to block b" + ("" if every else " (dots)")
+             + ":\n  the order between tiles (straight, as the cost\n  prices it), not the driven path")
     for k in numbered.tolist():
         x, y = refs[k]
         ax.text(x, y - (0.18 if every else 0.0), str(k + 1), ha="center", va="center", fontsize=font * 0.9,
                 color="white", fontweight="bold", in_layout=False, zorder=5,
                 bbox={"boxstyle": "circle,pad=0.15", "facecolor": "green" if k == 0 else _ORDER_COLOUR,
                       "edgecolor": "none"})
-    handles = [Line2D([], [], color=_ORDER_COLOUR, linewidth=1.3, marker=">" if every else ".", label=label),
+    handles = [Line2D([], [], color=_ORDER_COLOUR, linewidth=1.3, linestyle=dashes, alpha=_ORDER_ALPHA,
+                      marker=">" if every else ".", label=label),
                Line2D([], [], linestyle="none", marker="o", markersize=8, color=_ORDER_COLOUR,
                       label="visit number" if every else f"visit number (1, {step}, {2 * step}, …, {n})")]
     handles.append(Line2D([], [], linestyle="none", marker="o", markersize=8, color="green", label="start (visit 1)"))

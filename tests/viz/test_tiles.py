@@ -110,3 +110,14 @@ def test_coverage_obstacles_are_one_collection(small):
     assert blocked.get_hatch() == "xx"
     assert " s;" in ax.get_title()  # the average grid time, with its unit
     assert "not free (obstacle)" in legend_labels(ax)
+
+
+@pytest.mark.parametrize("which", ["small", "large"])
+def test_the_order_is_drawn_dashed_and_said_not_to_be_the_driven_path(which, request):
+    tileset = request.getfixturevalue(which)
+    ax = plot_tileset(tileset, list(tileset.ids)).axes[0]
+    order = gid(ax, "order")
+    styles = order.get_linestyles() if hasattr(order, "get_linestyles") else [order.get_linestyle()]
+    assert all(style not in ("-", "solid", (0, None)) for style in styles)  # dashed: the order, not a path
+    assert order.get_alpha() < 1
+    assert any("not the driven path" in label for label in legend_labels(ax))
