@@ -1,7 +1,8 @@
 """Plots of GA fronts and convergence (matplotlib is imported lazily; nothing here computes a front).
 
 A front is an array of fitnesses, one row per member and the columns (f_gr, f_t, f_sm, f_sf), all
-to be maximised, or the GA record it comes from: a :class:`~htetro_opt.solvers.grid_paths.Plan`
+to be maximised (f_t = 1 − t/t_max is negative for a path slower than t_max, f_sf beside many
+obstacles: the axes say what the values mean), or the GA record it comes from: a :class:`~htetro_opt.solvers.grid_paths.Plan`
 (its last leg's front) or a :class:`~htetro_opt.solvers.grid_paths.LegResult`. pymoo's ``F`` is
 the negation (pymoo minimises): pass ``-F``.
 
@@ -31,6 +32,19 @@ DEFAULT_OBJECTIVES = ("f_t", "f_sm", "f_sf")
 
 _MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*", "<", ">")
 _BETTER = "(higher is better)"
+_SCALES = {
+    "f_gr": "1: goal reached, 0: unreachable",
+    "f_t": "1 − t/t_max: 0 at t_max, < 0 slower",
+    "f_sm": "1: no change of command",
+    "f_sf": "1: no obstacle near, < 0 near many",
+}
+"""What a fitness's values mean: none is bounded to [0, 1] but f_gr and f_sm (f_t = 1 − t/t_max is
+negative for a path slower than t_max; f_sf = 1 − Σ D/(l_p λ_sp) is negative beside many obstacles)."""
+
+
+def _axis_label(name: str) -> str:
+    """An objective's axis label: its name, that higher is better, and what its values mean."""
+    return f"{name} {_BETTER}\n{_SCALES[name]}"
 
 
 # --------------------------------------------------------------------------------------------- checks
@@ -227,9 +241,9 @@ def plot_fronts(fronts, *, labels=None, objectives=DEFAULT_OBJECTIVES, title: st
             if i < k - 1:
                 ax.tick_params(labelbottom=False)
             if i == k - 1:
-                ax.set_xlabel(f"{FITNESS_OBJECTIVES[col]} {_BETTER}")
+                ax.set_xlabel(_axis_label(FITNESS_OBJECTIVES[col]), fontsize=8)
             if j == 0:
-                ax.set_ylabel("members" if i == 0 else f"{FITNESS_OBJECTIVES[row]} {_BETTER}")
+                ax.set_ylabel("members" if i == 0 else _axis_label(FITNESS_OBJECTIVES[row]), fontsize=8)
     for j in range(k - 1):  # a column's panels share the objective on x
         for i in range(j + 1, k):
             axes[i, j].sharex(axes[j, j])
@@ -416,8 +430,14 @@ def _draw_convergence(ax, legs) -> None:
     values, gens = np.vstack(pieces), np.concatenate(gens)
     for i, (name, colour) in enumerate(_FITNESS_STYLES):
         ax.plot(gens, values[:, i], color=colour, linewidth=1.4, label=name, gid=name, zorder=3)
+    if np.nanmin(values) < 0:  # f_t (slower than t_max) or f_sf (beside many obstacles) below 0
+        ax.axhline(0.0, color="#555555", linewidth=0.8, zorder=2, gid="zero")
+    from matplotlib.ticker import MaxNLocator
+
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))  # generations are whole
     ax.set_xlabel("generation" + (" (legs one after another)" if len(legs) > 1 else ""))
-    ax.set_ylabel(f"fitness {_BETTER}")
+    ax.set_ylabel(f"fitness {_BETTER}\nf_t = 1 − t/t_max: 0 at t_max, < 0 slower;\n"
+                  "f_sf < 0 near many obstacles; f_gr, f_sm in [0, 1]", fontsize=8)
     ax.grid(alpha=0.3)
     handles, labels = ax.get_legend_handles_labels()
     order = sorted(range(len(labels)), key=lambda n: labels[n] not in FITNESS_OBJECTIVES)  # fitnesses first

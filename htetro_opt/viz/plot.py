@@ -344,8 +344,9 @@ SELECTION_STYLES = {
 
 
 def _selection_track(plan, name: str, offset: float):
-    """B2's track of one selection over every leg (NaN between legs) and its total time, or None."""
-    pieces, total = [], 0.0
+    """B2's track of one selection over every leg (NaN between legs), its total time and whether it
+    reaches every leg's goal, or None."""
+    pieces, total, reached = [], 0.0, True
     for leg in plan.legs:
         member = leg.selected.get(name)
         if member is None or not len(member.poses):
@@ -353,7 +354,8 @@ def _selection_track(plan, name: str, offset: float):
         pieces.append(np.asarray(member.poses, dtype=float)[:, :2] + offset)
         pieces.append(np.full((1, 2), np.nan))
         total += float(member.time)
-    return (np.concatenate(pieces), total) if pieces else None
+        reached = reached and bool(getattr(member, "reached", True))
+    return (np.concatenate(pieces), total, reached) if pieces else None
 
 
 def plot_ga_plan(workspace: Workspace, plan, *, roadmap: tuple[Pose, ...] = (), hidden=None, title: str = ""):
@@ -376,7 +378,8 @@ def plot_ga_plan(workspace: Workspace, plan, *, roadmap: tuple[Pose, ...] = (), 
     matplotlib Figure
         Left: the map as :func:`plot_path` draws it, for the multi-objective path, with the B2 tracks
         of the four selections (offset slightly so overlapping tracks stay visible; the legend gives
-        each one's total time in s). Right: the multi-objective solution's four fitnesses per
+        each one's total time in s, and says "goal not reached" of a selection short of a leg's goal,
+        the GA's best try rather than a part of the plan). Right: the multi-objective solution's four fitnesses per
         generation, legs one after another.
     """
     plt = _pyplot()
@@ -391,10 +394,12 @@ def plot_ga_plan(workspace: Workspace, plan, *, roadmap: tuple[Pose, ...] = (), 
         track = _selection_track(plan, name, (k - 1.5) * 0.08)
         if track is None:
             continue
-        xy, total = track
+        xy, total, reached = track
         width = 2.2 if name == "multi_objective" else 1.3
         ax_map.plot(xy[:, 0], xy[:, 1], color=colour, linewidth=width, zorder=4 if name == "multi_objective" else 3)
-        handles.append(_marker_handle(f"{label}, {total:g} s", linestyle="-", color=colour, linewidth=width))
+        # a selection short of a goal is the GA's best try, not part of the plan (whose time the title may give)
+        shown = f"{label}, {total:g} s" + ("" if reached else ", goal not reached")
+        handles.append(_marker_handle(shown, linestyle="-", color=colour, linewidth=width))
     _legend(ax_map, handles)
     _frame(ax_map, workspace, title)
 

@@ -57,8 +57,11 @@ def test_scatter_panels_plot_the_fronts_columns(ga_plan, objectives):
                 assert np.array_equal(points, front[:, [column[x_name], column[y_name]]])
     assert legend_labels(fig) == ["nsga2-like", "htetro-ga", "first leg"]
     bottom = [fig.axes[(k - 1) * k + j].get_xlabel() for j in range(k)]
-    assert bottom == [f"{name} (higher is better)" for name in objectives]
-    assert [fig.axes[i * k].get_ylabel() for i in range(1, k)] == [f"{n} (higher is better)" for n in objectives[1:]]
+    assert [label.split("\n")[0] for label in bottom] == [f"{name} (higher is better)" for name in objectives]
+    left = [fig.axes[i * k].get_ylabel() for i in range(1, k)]
+    assert [label.split("\n")[0] for label in left] == [f"{n} (higher is better)" for n in objectives[1:]]
+    if "f_t" in objectives:  # f_t = 1 − t/t_max goes negative for a path slower than t_max: its axis says so
+        assert "< 0 slower" in bottom[objectives.index("f_t")]
     assert fig._suptitle.get_text() == "three fronts"
 
 
@@ -142,6 +145,14 @@ def test_convergence_of_one_leg_or_an_array_has_no_separator(ga_plan):
         lines = {line.get_gid(): line for line in ax.lines}
         assert np.array_equal(lines["f_sf"].get_ydata(), history[:, 3])
         assert ax.get_xlabel() == "generation"
+
+
+def test_a_negative_f_t_is_labelled_and_has_its_zero_line():
+    ax = plot_convergence([[0.1, -0.4, 0.5, 0.9], [0.2, -0.1, 0.6, 0.9]]).axes[0]  # slower than t_max
+    assert ax.get_ylabel().startswith("fitness (higher is better)") and "< 0 slower" in ax.get_ylabel()
+    assert [line.get_ydata()[0] for line in ax.lines if line.get_gid() == "zero"] == [0.0]
+    ax = plot_convergence([[0.1, 0.4, 0.5, 0.9]]).axes[0]
+    assert not [line for line in ax.lines if line.get_gid() == "zero"]
 
 
 @pytest.fixture(scope="module")
