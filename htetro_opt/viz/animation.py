@@ -49,6 +49,7 @@ MAX_FPS = 50.0
 _MAP_INCHES = 5.0  # the map's longer side on the figure
 _MARGINS = {"left": 0.65, "right": 0.25, "bottom": 0.5, "status": 0.32, "title_line": 0.2, "top": 0.08}
 _EDGE_COLOUR = "#222222"
+_TRAIL_COLOUR = "black"  # B2's path so far (one of the palette's colours: no blend to quantise)
 _UNIT_SQUARE = np.array([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]])
 
 
@@ -76,6 +77,8 @@ class PathAnimation:
         One square per moving-obstacle cell (None without moving obstacles).
     status : matplotlib Text
         The step counter and the time, above the map.
+    trail : matplotlib Line2D
+        B2's path so far: its cell at each pose up to the frame's, then where B2 is at the frame.
     """
 
     def __init__(self, figure, poses, steps, fractions, *, commands, times, motions, moving, artists):
@@ -93,6 +96,7 @@ class PathAnimation:
         self._labels = artists.get("labels", ())
         self._marker = artists.get("marker")
         self._hidden = artists.get("hidden")
+        self.trail = artists["trail"]
         figure.canvas.draw()  # everything but the animated artists: the background of every frame
         self._background = figure.canvas.copy_from_bbox(figure.bbox)
         self._palette = _palette(np.asarray(figure.canvas.buffer_rgba())[..., :3], _dynamic_colours())
@@ -142,6 +146,9 @@ class PathAnimation:
             axis=-1)
         self.robot.set_verts(corners)
         self.robot.set_facecolor(_colour(state))
+        done = self.poses[: int(self.steps[i]) + 1, :2].astype(float)
+        track = np.vstack([done, centres[1:2]])  # B2 is block 2: where it is now, mid-command
+        self.trail.set_data(track[:, 0], track[:, 1])
         for label, (x, y) in zip(self._labels, centres):
             label.set_data([x], [y])
         if self._marker is not None:
@@ -149,7 +156,7 @@ class PathAnimation:
         if self.obstacles is not None:
             self.obstacles.set_verts(_squares(self._obstacle_cells(i)))
         self.status.set_text(self._status_text(i))
-        drawn = (self.obstacles, self.robot, *self._labels, self._marker, self._hidden, self.status)
+        drawn = (self.obstacles, self.trail, self.robot, *self._labels, self._marker, self._hidden, self.status)
         return tuple(a for a in drawn if a is not None)
 
     def _status_text(self, i: int) -> str:
@@ -215,7 +222,9 @@ def animate_path(
 
     Drawn once: the map (obstacles grey, as :func:`~htetro_opt.viz.plot_path` draws it), the moving
     obstacles' tracks (dotted), the roadmap poses' outlines (dashed: start green, intermediate blue,
-    goal red) and the title. Drawn each frame: the four blocks, filled in their state's colour
+    goal red) and the title. Drawn each frame: B2's path so far (a black line through its cell at
+    each pose up to the frame's, then to where B2 is mid-command; a dot a pose where cells are
+    large enough), the four blocks, filled in their state's colour
     (:data:`~htetro_opt.viz.SHAPE_COLOURS`, grey for an intermediate state) and numbered 1–4 where a
     cell is large enough (on a dense map a ring marks B2 instead), the moving obstacles (hatched) and
     the hidden obstacles (cross-hatched, over the robot so a path through them shows).
@@ -443,6 +452,11 @@ def _figure(workspace: Workspace, roadmap, hidden: np.ndarray, title: str, dpi: 
         artists["obstacles"] = ax.add_collection(PolyCollection(
             [], facecolors=_MOVING_COLOUR, edgecolors="white", hatch="//", linewidths=0, zorder=3, animated=True))
     _draw_roadmap(ax, roadmap, dense=dense)
+    artists["trail"], = ax.plot([], [], color=_TRAIL_COLOUR, linewidth=1.3 if dense else 1.6, marker=None if dense
+                                else ".", markersize=4, zorder=4.5, animated=True)
+    if map_w >= 4.0:  # room beside the status line for a key
+        fig.text(1 - m["right"] / fig_w, (m["bottom"] + map_h + 0.08) / fig_h,
+                 f"{_TRAIL_COLOUR} line: B2's path so far", ha="right", va="bottom", fontsize=7, color="#444444")
     artists["robot"] = ax.add_collection(PolyCollection(
         [], edgecolors=_EDGE_COLOUR, linewidths=0 if dense else 1.0, zorder=5, animated=True))
     if dense:  # a block is a few pixels: a ring marks where B2 is

@@ -236,3 +236,18 @@ def test_importing_viz_does_not_import_matplotlib_or_pillow():
     code = "import sys, htetro_opt.viz; print('matplotlib' in sys.modules, 'PIL' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["False", "False"]
+
+
+def test_the_trail_is_b2_s_path_up_to_the_frame():
+    sequence, poses = random_plan(OPEN, Pose(5, 5, "I"), 12, seed=5)
+    k = 2
+    anim = animate_path(OPEN, sequence, Pose(5, 5, "I"), frames_per_step=k)
+    for i in range(len(anim)):
+        drawn = anim.draw_frame(i)
+        assert anim.trail in drawn and drawn.index(anim.trail) < drawn.index(anim.robot)  # under the robot
+        track = np.column_stack(anim.trail.get_data())
+        step = int(anim.steps[i])
+        assert np.array_equal(track[:-1], poses[: step + 1, :2])
+        b2 = np.array([path.vertices[:4].mean(axis=0) for path in anim.robot.get_paths()])[1]
+        assert np.allclose(track[-1], b2)  # then to where B2 is, mid-command
+    assert np.array_equal(np.column_stack(anim.trail.get_data())[:-1], poses[:, :2])  # the last frame: the whole path
