@@ -94,3 +94,46 @@ def test_bad_input():
         plot_cover(Workspace(np.zeros((5, 6), dtype=bool)), plan_coverage(ws, "O"))
     with pytest.raises(ParameterError, match="bins"):
         plot_cover_heat(plan_coverage(ws, "O"), bins=0)
+
+
+@pytest.fixture(scope="module")
+def tiling_tsp_16x16():
+    sc = load_scenario("coverage_16x16")
+    return sc.workspace, plan_coverage(sc.workspace, method="tiling-tsp")
+
+
+def legend_labels(ax):
+    return [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+def test_the_start_and_the_end_of_a_plan_are_marked_and_in_the_legend(tiling_tsp_16x16):
+    ws, plan = tiling_tsp_16x16
+    assert plan.goal is None  # no goal: the end is wherever the plan stops
+    ax = plot_cover(ws, plan).axes[0]
+    assert by_gid(ax, "start")[0].get_offsets().tolist() == [[plan.start.x, plan.start.y]]
+    assert by_gid(ax, "end")[0].get_offsets().tolist() == [plan.poses[-1, :2].tolist()]
+    labels = legend_labels(ax)
+    assert any(label.startswith("start (") for label in labels)
+    assert any(label.startswith("end of the plan (") and f"after {len(plan.commands)} commands" in label
+               for label in labels)
+
+
+def test_a_long_plan_is_a_line_with_sparse_arrows_and_every_move_drawn(tiling_tsp_16x16):
+    ws, plan = tiling_tsp_16x16
+    poses = plan.poses
+    moves = int((poses[1:, :2] != poses[:-1, :2]).any(axis=1).sum())
+    assert moves > 150  # more than the default arrows: the line
+    ax = plot_cover(ws, plan).axes[0]
+    lines = [a for a in ax.collections if str(a.get_gid()).startswith("path ")]
+    assert sum(len(line.get_segments()) for line in lines) == moves  # every move, the ones in no layer too
+    assert "path other" in {line.get_gid() for line in lines}
+    quivers = [a for a in ax.collections if str(a.get_gid()).startswith("arrows ")]
+    assert 0 < sum(q.N for q in quivers) <= 150 / 3
+    assert any(label.startswith(f"{moves} moves: a line") for label in legend_labels(ax))
+    # with room for every arrow, one a move, from B2's cell
+    ax = plot_cover(ws, plan, arrows=1000).axes[0]
+    quivers = [a for a in ax.collections if str(a.get_gid()).startswith("arrows ")]
+    assert sum(q.N for q in quivers) == moves and not [a for a in ax.collections if str(a.get_gid()).startswith("path ")]
+    with pytest.raises(ParameterError, match="arrows"):
+        plot_cover(ws, plan, arrows=0)
+
