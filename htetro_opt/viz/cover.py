@@ -312,12 +312,12 @@ def plot_cover_heat(plan, *, title: str = "", bins: int = 30):
     plt = _pyplot()
     fig, (left, right) = plt.subplots(1, 2, figsize=(12.0, max(3.5, 6.0 * h / w) + 1.0),
                                       gridspec_kw={"width_ratios": [3, 2]}, layout="constrained")
-    plot_coverage(result, title=title, ax=left)
+    plot_coverage(result, title=title, ax=left, time_unit="command units")  # a plan's clock: one a command
     p = result.pixels_per_cell
     times = result.pixel_time[np.kron(result.free, np.ones((p, p), dtype=bool))]
     right.hist(times, bins=bins, color="#4c72b0", edgecolor="white", gid="pixel-time histogram")
     right.axvline(result.average_grid_time, color="black", linestyle="--", linewidth=1.2,
-                  label=f"average coverage time {result.average_grid_time:.3f}")
+                  label=f"average coverage time {result.average_grid_time:.3f} command units")
     right.set_xlabel("time a pixel is covered (command units)")
     right.set_ylabel("pixels of free cells")
     right.set_title(f"{plan.recovered_pct:.1f} % of coverable cells re-covered (≥ 1.5)", fontsize=10)

@@ -228,7 +228,7 @@ def _draw_order(ax, refs: np.ndarray, cell_pt: float) -> list:
     return handles
 
 
-def plot_coverage(result, *, title: str = "", ax=None):
+def plot_coverage(result, *, title: str = "", ax=None, time_unit: str = "s"):
     """Draw a coverage heat map (Le et al. 2018, Fig. 18): pixel time scaled to 0…255, green to red.
 
     Parameters
@@ -238,6 +238,10 @@ def plot_coverage(result, *, title: str = "", ax=None):
     title : str, keyword-only
         Above the map; a line with the average grid time and the distance is added below it.
     ax : matplotlib Axes, optional, keyword-only
+    time_unit : str, keyword-only
+        The unit of the result's times, written after the average grid time: seconds for
+        :func:`~htetro_opt.model.coverage.simulate_coverage`'s runs, ``"command units"`` for a
+        coverage plan's (:func:`~htetro_opt.model.coverage.simulate_command_coverage`).
 
     Returns
     -------
@@ -256,6 +260,8 @@ def plot_coverage(result, *, title: str = "", ax=None):
     for attribute in ("heat", "free", "cell_time", "average_grid_time", "distance", "mean_block_distance"):
         if not hasattr(result, attribute):
             raise ParameterError(f"result must be a CoverageResult, got {type(result).__name__}")
+    if not isinstance(time_unit, str) or not time_unit:
+        raise ParameterError(f"time_unit must be a non-empty string, got {time_unit!r}")
     plt = _pyplot()
     from matplotlib.collections import PolyCollection
     from matplotlib.patches import Patch
@@ -281,7 +287,7 @@ def plot_coverage(result, *, title: str = "", ax=None):
     per_block = f"{result.mean_block_distance:.1f} cells"
     if result.distance_m is not None:
         per_block += f" = {result.distance_m / 4:.2f} m"
-    summary = (f"avg grid time {result.average_grid_time:.3f} s; travel: 4 blocks {result.distance:.1f} cells, "
+    summary = (f"avg grid time {result.average_grid_time:.3f} {time_unit}; travel: 4 blocks {result.distance:.1f} cells, "
                f"per block {per_block}")
     _frame(ax, w, h, f"{title}\n{summary}" if title else summary)
     return fig

@@ -137,3 +137,11 @@ def test_a_long_plan_is_a_line_with_sparse_arrows_and_every_move_drawn(tiling_ts
     with pytest.raises(ParameterError, match="arrows"):
         plot_cover(ws, plan, arrows=0)
 
+
+def test_the_heat_figure_gives_one_time_unit_on_both_panels(case_16x7):
+    _, plan = case_16x7
+    fig = plot_cover_heat(plan)
+    left, right = fig.axes[:2]
+    assert "command units" in left.get_title() and " s;" not in left.get_title()
+    assert "command units" in right.get_xlabel()
+    assert all(t.get_text().endswith("command units") for t in right.get_legend().get_texts())
