@@ -64,6 +64,11 @@ def _check_field(field, name: str = "field"):
     return field
 
 
+def _is_several(field) -> bool:
+    """Whether ``field`` is a sequence of more than one field (one per leg or per replan)."""
+    return isinstance(field, Sequence) and not isinstance(field, (str, bytes)) and len(field) > 1
+
+
 def _last_field(field):
     """``field`` itself, or the last of a non-empty sequence of fields (one per leg or per replan)."""
     if isinstance(field, Sequence) and not isinstance(field, (str, bytes)):
@@ -242,7 +247,7 @@ def _draw_replans(ax, replans: list[Pose]) -> list:
 
 
 def _draw_heat(ax, field, workspace: Workspace, poses, replans: list[Pose], *, arrows: int, colorbar: bool,
-               title: str | None, revealed: np.ndarray, hidden=None) -> None:
+               title: str | None, revealed: np.ndarray, hidden=None, later: bool = False) -> None:
     plt = _pyplot()
     cells = np.asarray(field.cells, dtype=float)
     dense = _cell_points(ax, workspace.width, workspace.height) < DENSE_CELL_PT
@@ -281,7 +286,10 @@ def _draw_heat(ax, field, workspace: Workspace, poses, replans: list[Pose], *, a
         handles += _draw_track(ax, poses, dense=dense)
     handles += _draw_replans(ax, replans)
     if colorbar:
-        _colour_bar(ax, image, "temperature T (sink: start 0, source: goal 1)", shrink=0.85, pad=0.02)
+        # after a replan (or of several legs' fields) the field drawn is the last plan's: its sink is
+        # where that plan started, not the start marked on the path
+        ends = "0 at the last plan's start, 1 at its goal" if later else "sink: start 0, source: goal 1"
+        _colour_bar(ax, image, f"temperature T ({ends})", shrink=0.85, pad=0.02)
     _frame(ax, workspace, "temperature field T and ∇T" if title is None else title)
     if handles:
         ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2, fontsize=8,
@@ -293,7 +301,8 @@ def plot_heat_field(field, *, workspace: Workspace | None = None, poses=None, re
     """Draw a temperature field, its gradient and a path: panel (b) of Do et al. 2021's Figs. 7–12.
 
     Drawn, with a legend under the map: the cell temperatures as an image (the :data:`HEAT_COLORMAP`
-    from 0 at the sink, the start's B2 cell, to 1 at the source, the goal's); obstacles in
+    from 0 at the sink, the start's B2 cell, to 1 at the source, the goal's; of several fields or with
+    replans, the last plan's start and goal, which the colour bar's label then says); obstacles in
     :func:`~htetro_opt.viz.plot_path`'s grey; free cells without a temperature (regions cut off from
     the start and the goal) white; ∇T as unit arrows (the direction in which the temperature rises,
     which a heat plan climbs) at a square lattice of cells, at most ``arrows`` a side; B2's path as a
@@ -351,6 +360,7 @@ def plot_heat_field(field, *, workspace: Workspace | None = None, poses=None, re
     ['temperature', 'gradient', 'path']
     >>> import matplotlib.pyplot as plt; plt.close(ax.figure)
     """
+    several = _is_several(field)
     field = _last_field(field)
     cells = np.asarray(field.cells, dtype=float)
     workspace = _check_map(workspace, cells)
@@ -363,7 +373,7 @@ def plot_heat_field(field, *, workspace: Workspace | None = None, poses=None, re
     revealed = _revealed_cells(replans, hidden, cells, workspace)
     _, ax = _map_figure(workspace, ax)
     _draw_heat(ax, field, workspace, poses, replan_poses, arrows=arrows, colorbar=colorbar, title=title,
-               revealed=revealed, hidden=hidden)
+               revealed=revealed, hidden=hidden, later=several or bool(replan_poses))
     return ax
 
 
@@ -409,6 +419,7 @@ def plot_heat_plan(workspace: Workspace, plan, field, *, replans=None, roadmap=(
         If ``path``'s folder does not exist or cannot be written (checked before drawing).
     """
     workspace = check_workspace(workspace)
+    several = _is_several(field)
     field = _last_field(field)
     _check_map(workspace, np.asarray(field.cells, dtype=float))
     if not hasattr(plan, "poses"):
@@ -438,7 +449,7 @@ def plot_heat_plan(workspace: Workspace, plan, field, *, replans=None, roadmap=(
         ax_path.get_legend().remove()
         _legend(ax_path, handles)
     _draw_heat(ax_heat, field, workspace, poses, replan_poses, arrows=arrows, colorbar=True, title=None,
-               revealed=revealed, hidden=hidden)
+               revealed=revealed, hidden=hidden, later=several or bool(replan_poses))
     if title:
         fig.suptitle(title, fontsize=11)
     if path is not None:

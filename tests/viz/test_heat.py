@@ -252,6 +252,8 @@ def test_obstacles_revealed_while_replanning_are_drawn_as_such_not_as_free_cells
         assert f"revealed obstacle: hidden, then sensed ({len(revealed)})" in legend_labels(ax)
     assert not [label for label in legend_labels(ax_heat) if label.startswith("free")]  # they are not free
     assert not [label for label in legend_labels(ax_path) if label.startswith("hidden obstacle")]  # all sensed
+    # the field drawn is the last plan's, solved from where the robot replanned: the colour bar says so
+    assert "last plan's start" in fig.axes[2].get_ylabel()
     # without the replans' records, the hidden cells the field has no temperature on are the revealed ones
     ax = plot_heat_field(run.fields, workspace=scenario.workspace, hidden=scenario.hidden, arrows=0)
     assert "revealed obstacles" in gids(ax)
