@@ -254,8 +254,9 @@ def _draw_heat(ax, field, workspace: Workspace, poses, replans: list[Pose], *, a
     # obstacles in plot_path's grey, under the image; hidden ones the field still has a temperature on
     # (not yet sensed when it was solved) cross-hatched over it
     unknown = _hidden_cells(hidden)
-    if len(unknown):
-        unknown = unknown[~np.isin(_cell_keys(unknown), _cell_keys(revealed))]
+    h, w = cells.shape
+    unknown = unknown[(unknown[:, 0] >= 0) & (unknown[:, 0] < w) & (unknown[:, 1] >= 0) & (unknown[:, 1] < h)]
+    unknown = unknown[~np.isnan(cells[unknown[:, 1], unknown[:, 0]])]  # the field has a temperature there
     handles = _draw_map(ax, workspace, None, dense=dense)
     cmap = plt.get_cmap(HEAT_COLORMAP).with_extremes(bad=(0.0, 0.0, 0.0, 0.0))  # no temperature: the map shows
     image = ax.imshow(np.ma.masked_invalid(cells), cmap=cmap, vmin=0.0, vmax=1.0, origin="lower",

@@ -257,3 +257,13 @@ def test_obstacles_revealed_while_replanning_are_drawn_as_such_not_as_free_cells
     # without the replans' records, the hidden cells the field has no temperature on are the revealed ones
     ax = plot_heat_field(run.fields, workspace=scenario.workspace, hidden=scenario.hidden, arrows=0)
     assert "revealed obstacles" in gids(ax)
+    # a field solved before any sensing has a temperature on the hidden cells: they are hidden, not revealed
+    start, goal = scenario.start, scenario.goal
+    first = solve_heat_field(scenario.workspace, (goal.x, goal.y), (start.x, start.y))
+    ax = plot_heat_field(first, workspace=scenario.workspace, hidden=scenario.hidden, arrows=0)
+    assert "revealed obstacles" not in gids(ax) and "hidden obstacles" in gids(ax)
+    assert "hidden obstacle, not sensed when this field was solved" in legend_labels(ax)
+    # nor is an obstacle of the map (the true map, as notebook 02 passes) drawn as hidden or revealed
+    fig = plot_heat_plan(scenario.true_workspace(), run, run.fields, replans=run.replans, roadmap=scenario.roadmap,
+                         hidden=scenario.hidden)
+    assert not {"revealed obstacles", "hidden obstacles"} & set(gids(fig.axes[1]))
