@@ -656,8 +656,8 @@ def _words(value) -> str:
         return "on" if value else "off"
     if isinstance(value, float):
         return f"{value:g}"
-    if isinstance(value, (list, tuple)):
-        return ",".join(_words(v) for v in value)
+    if isinstance(value, (list, tuple, set, frozenset)):
+        return ",".join(_words(v) for v in value) if value else "none"  # an empty set is said
     return str(value)
 
 

@@ -393,4 +393,4 @@ def test_the_sequence_methods_add_the_fields_listed(examples):
         taken = SPEC.method(method).takes  # LKH counts runs, not seconds; the patterns take neither
         options = {k: v for k, v in {"time_limit": 0.2, "seed": 0}.items() if taken(k)}
         result = sequence_waypoints(instance, method=method, **options)
-        assert set(result.info) == listed[method], method
+        assert set(result.info) - {"additions"} == listed[method], method  # additions: a field of its own

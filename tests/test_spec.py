@@ -202,7 +202,7 @@ def test_resume_re_runs_the_records_whose_method_changed_and_says_how_many(tmp_p
     from htetro_opt.solvers.sequencing import SPEC
     from htetro_opt.studies.runner import Study, read_records, run_study
 
-    study = Study(name="stale", task="sequence", scenarios=["paper_6x6_fig13a"],
+    study = Study(name="stale", task="sequence", scenarios=["paper_6x6_fig13a"], metrics=(),
                   methods=[{"method": "exact"}, {"method": "zigzag"}])
     first = run_study(study, out=tmp_path, executor="serial")
     assert first.stale == 0

@@ -35,6 +35,7 @@ METRICS = {
 }
 """Optional metrics per task, beyond those every record holds (see :mod:`htetro_opt.studies.runner`)."""
 
+_DEFAULT_METRICS = ("gap",)  # where the task has it (_check_metrics keeps the task's own)
 _GA_METRICS = ("front", "history", "hv_curve")  # of a population: the exact planners have none
 _TOP_KEYS = ("name", "description", "task", "scenarios", "seeds", "metrics", "methods")
 _ENTRY_KEYS = ("method", "label", "scenarios", "per_scenario")
@@ -91,8 +92,9 @@ class Study:
     seeds : int or sequence of int
         N for seeds 0 … N−1, or the seeds themselves (default 1). A method whose spec says it does not
         draw from the seed (for its options) runs once.
-    metrics : sequence of str
-        Optional metrics of the task (:data:`METRICS`).
+    metrics : sequence of str, optional
+        Optional metrics of the task (:data:`METRICS`). Default ``["gap"]`` where the task has it,
+        so that a summary sets every method beside the exact reference; ``[]`` measures none.
     description : str
     source : str, optional
         The study file, named in error messages; relative scenario paths start from its folder.
@@ -119,7 +121,7 @@ class Study:
     scenarios: tuple[str, ...]
     methods: tuple[MethodEntry, ...]
     seeds: tuple[int, ...] = (0,)
-    metrics: tuple[str, ...] = ()
+    metrics: tuple[str, ...] | None = None
     description: str = ""
     source: str | None = field(default=None, compare=False)
 
@@ -137,7 +139,7 @@ class Study:
         scenarios, written = _check_scenarios(self.task, self.scenarios, base, where)
         spec = _spec_of_scenarios(self.task, scenarios, where)
         seeds = _check_seeds(self.seeds, f"{where}: seeds")
-        metrics = _check_metrics(self.task, self.metrics, where)
+        metrics = _check_metrics(self.task, _DEFAULT_METRICS if self.metrics is None else self.metrics, where)
         methods = _check_methods(self.task, spec, self.methods, scenarios, written, where)
         for i, entry in enumerate(methods):
             _check_ga_metrics(spec, entry.method, metrics, f"{where}, methods[{i}]")
@@ -245,6 +247,8 @@ def _check_metrics(task, metrics, where) -> tuple[str, ...]:
     if isinstance(metrics, str) or not isinstance(metrics, Sequence):
         raise StudyError(f"{where}: metrics must be a list of names ({', '.join(known) or 'none for ' + task}), "
                          f"got {metrics!r}")
+    if metrics is _DEFAULT_METRICS:
+        return tuple(m for m in known if m in metrics)
     for i, metric in enumerate(metrics):
         if metric not in known:
             raise StudyError(f"{where}: metrics[{i}]: unknown metric {metric!r} for task {task}: expected "
@@ -437,5 +441,5 @@ def load_study(name_or_path: str | os.PathLike) -> Study:
         if key not in data:
             raise StudyError(f"{where}: {key} is missing")
     return Study(name=data.get("name", path.stem), task=data["task"], scenarios=data["scenarios"],
-                 methods=data["methods"], seeds=data.get("seeds", 1), metrics=data.get("metrics", ()),
+                 methods=data["methods"], seeds=data.get("seeds", 1), metrics=data.get("metrics"),
                  description=data.get("description", ""), source=str(path))

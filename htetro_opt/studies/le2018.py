@@ -96,7 +96,8 @@ TABLE2_SCENARIOS = ("paper_10x10_fig13c",)
 """Table 2's map: the paper's 10 × 10 tileset."""
 METHOD_NAMES = {
     "zigzag": "Zigzag 1 row", "zigzag2": "Zigzag 2 rows", "spiral": "Spiral 1 row", "spiral2": "Spiral 2 rows",
-    "greedy": "Greedy search", "ga-plain": "GA (paper's, DEAP)", "ga": "GA + 2-opt/Or-opt (memetic)",
+    "greedy": "Greedy search", "ga-plain": "GA as published (ga-plain)",
+    "ga": "GA with our additions (ga)",
     "ortools": "OR-Tools GLS", "local": "NN + 2-opt/Or-opt", "exact": "Exact (CP-SAT)",
 }
 
@@ -150,6 +151,13 @@ def _check_seeds(seeds) -> list[int]:
     return [check_int(s, f"seeds[{i}]", minimum=0) for i, s in enumerate(seeds)]
 
 
+def _on_paper_map(tileset: Tileset, scenarios: Sequence[str]) -> bool:
+    """Whether ``tileset`` tiles the map a paper table is about: one of ``scenarios``, as bundled or as our
+    tiling of it (named ``ours <scenario> (…)`` by :func:`_tileset`)."""
+    words = tileset.name.split()
+    return tileset.name in scenarios or (len(words) > 1 and words[0] == "ours" and words[1] in scenarios)
+
+
 def run_table1(tileset: Tileset, *, seeds: Iterable[int] = (0,), methods: Sequence[str] = TABLE1_METHODS,
                time_limit: float | None = None) -> list[dict]:
     """Every method on one tileset from tile 1: one record per (method, seed), with the gap to the optimum.
@@ -170,7 +178,8 @@ def run_table1(tileset: Tileset, *, seeds: Iterable[int] = (0,), methods: Sequen
                 options["time_limit"] = time_limit
             result = optimum if method == "exact" else sequence_waypoints(instance, method=method, **options)
             records.append({
-                "table": 1, "tileset": tileset.name, "method": method, "seed": seed, "cost": result.cost,
+                "table": 1, "tileset": tileset.name, "paper_map": _on_paper_map(tileset, TABLE1_SCENARIOS),
+                "method": method, "seed": seed, "cost": result.cost,
                 "runtime_s": result.runtime_s, "optimum": optimum.cost,
                 "proven": bool(optimum.info.get("optimal", False)),
                 "gap_pct": 100.0 * (result.cost - optimum.cost) / optimum.cost, "order": result.tiles,
@@ -181,12 +190,16 @@ def run_table1(tileset: Tileset, *, seeds: Iterable[int] = (0,), methods: Sequen
 def run_table2(tileset: Tileset) -> list[dict]:
     """Table 2: the optimal order under each weight setting, priced by its own and by equal weights."""
     equal = SequencingInstance.from_tileset(tileset, start=tileset.ids[0])
+    paper_map = _on_paper_map(tileset, TABLE2_SCENARIOS)  # the paper's numbers are of its 10 x 10 map only
     records = []
     for weights, meaning, paper_own, paper_four in PAPER_TABLE2:
+        if not paper_map:
+            paper_own = paper_four = None
         instance = SequencingInstance.from_tileset(tileset, start=tileset.ids[0], weights=weights)
         result = sequence_waypoints(instance, method="exact")
         records.append({
-            "table": 2, "tileset": tileset.name, "weights": ",".join(f"{w:g}" for w in weights), "meaning": meaning,
+            "table": 2, "tileset": tileset.name, "paper_map": paper_map,
+            "weights": ",".join(f"{w:g}" for w in weights), "meaning": meaning,
             "cost_own": result.cost, "cost_four": path_cost(equal.cost, result.order),
             "paper_own": paper_own, "paper_four": paper_four, "proven": bool(result.info.get("optimal", False)),
         })
@@ -244,8 +257,9 @@ def run_table45(tileset: Tileset, table1: Iterable[dict]) -> list[dict]:
         order = [tileset.index(t) for t in row["order"]]
         runs.append((row, simulate_coverage(tileset, order)))
     scale = max(float(coverage.cell_time.max()) for _, coverage in runs)
+    paper_map = _on_paper_map(tileset, TABLE1_SCENARIOS)  # the paper's Tables 4-5 are of its 11 x 11 map
     return [{
-        "table": 4, "tileset": tileset.name, "method": row["method"], "cost": row["cost"],
+        "table": 4, "tileset": tileset.name, "paper_map": paper_map, "method": row["method"], "cost": row["cost"],
         "distance_cells": float(coverage.mean_block_distance),
         "distance_cm": 100.0 * tileset.cell_size * float(coverage.mean_block_distance),
         "average_grid_time_s": float(coverage.average_grid_time),
@@ -266,15 +280,16 @@ def markdown_report(records: Iterable[dict]) -> str:
         rows = [r for r in records if r["table"] == 1 and r["tileset"] == name]
         optimum = rows[0]["optimum"]
         best = "no optimum" if optimum is None else f"optimum {optimum:.3f}{'' if rows[0]['proven'] else ' (not proven)'}"
+        elsewhere = "" if rows[0].get("paper_map", True) else "; the paper's Table 1 is on its 11 × 11 map, not this one"
         out += [f"### Table 1 on {name} ({len(rows[0]['order'])} waypoints, start tile {rows[0]['order'][0]}; "
-                f"{best})", "",
+                f"{best}{elsewhere})", "",
                 "| method | cost (ours) | gap to optimum | time s (ours) | cost (paper) | time s (paper) |",
                 "|---|---|---|---|---|---|"]
         for method in dict.fromkeys(r["method"] for r in rows):
             mine = [r for r in rows if r["method"] == method]
             cost, gap, runtime = (mean_std([r[k] for r in mine if r[k] is not None])
                                   for k in ("cost", "gap_pct", "runtime_s"))
-            paper = PAPER_TABLE1.get(method, (None, None))
+            paper = PAPER_TABLE1.get(method, (None, None)) if rows[0].get("paper_map", True) else (None, None)
             runs = f" ({len(mine)} seeds)" if len(mine) > 1 else ""
             out.append(f"| {METHOD_NAMES.get(method, method)}{runs} | {format_mean_std(*cost, digits=3)} | "
                        f"{format_mean_std(*gap, digits=2)} % | {format_mean_std(*runtime, digits=3)} | "
@@ -282,7 +297,8 @@ def markdown_report(records: Iterable[dict]) -> str:
         out.append("")
     for name in dict.fromkeys(r["tileset"] for r in records if r["table"] == 2):
         rows = [r for r in records if r["table"] == 2 and r["tileset"] == name]
-        out += [f"### Table 2 on {name}: optimal order under each weight setting", "",
+        elsewhere = "" if rows[0].get("paper_map", True) else " (the paper's Table 2 is on its 10 × 10 map, not this one)"
+        out += [f"### Table 2 on {name}: optimal order under each weight setting{elsewhere}", "",
                 "| weights α,β,λ,γ | meaning | cost, own weights (ours) | cost, 4 blocks (ours) | own (paper) | 4 blocks (paper) |",
                 "|---|---|---|---|---|---|"]
         out += [f"| {r['weights']} | {r['meaning']} | {r['cost_own']:.3f} | {r['cost_four']:.3f} | "
@@ -301,8 +317,9 @@ def markdown_report(records: Iterable[dict]) -> str:
                 "| method | distance cm (ours) | (paper) | avg grid time s (ours) | (paper) | "
                 "re-covered >150 (ours) | (paper) | >100 (ours) | (paper) |", "|---|---|---|---|---|---|---|---|---|"]
         for r in rows:
-            t4 = PAPER_TABLE4.get(r["method"], (None, None))
-            t5 = PAPER_TABLE5.get(r["method"], (None, None))
+            paper = r.get("paper_map", True)  # the paper's Tables 4-5 are on its 11 x 11 map
+            t4 = PAPER_TABLE4.get(r["method"], (None, None)) if paper else (None, None)
+            t5 = PAPER_TABLE5.get(r["method"], (None, None)) if paper else (None, None)
             out.append(f"| {METHOD_NAMES.get(r['method'], r['method'])} | {r['distance_cm']:.0f} | {_fmt(t4[1], 0)} | "
                        f"{r['average_grid_time_s']:.3f} | {_fmt(t4[0], 4)} | {r['recovered_150']:.2f} % | "
                        f"{_fmt(t5[0], 2)} | {r['recovered_100']:.2f} % | {_fmt(t5[1], 2)} |")
@@ -440,15 +457,19 @@ def _legacy_records(run: StudyRun) -> list[dict]:
         if r.get("weights") is None:
             gap = None if optimum is None else 100.0 * (r["cost"] - optimum) / optimum
             table1.setdefault(ts.name, []).append({
-                "table": 1, "tileset": ts.name, "method": r["label"], "seed": r["seed"], "cost": r["cost"],
+                "table": 1, "tileset": ts.name, "paper_map": _on_paper_map(ts, TABLE1_SCENARIOS),
+                "method": r["label"], "seed": r["seed"], "cost": r["cost"],
                 "runtime_s": r["runtime_s"], "optimum": optimum, "proven": bool(ref and ref.get("optimal")),
                 "gap_pct": gap, "order": order})
         else:
             weights = tuple(float(w) for w in r["weights"])
             paper = {tuple(w): (meaning, own, four) for w, meaning, own, four in PAPER_TABLE2}.get(weights)
+            if not _on_paper_map(ts, TABLE2_SCENARIOS):  # the paper's Table 2 is on its 10 x 10 map only
+                paper = None if paper is None else (paper[0], None, None)
             equal = SequencingInstance.from_tileset(ts, start=order[0])
             table2.append({
-                "table": 2, "tileset": ts.name, "weights": _weights_label(weights),
+                "table": 2, "tileset": ts.name, "paper_map": _on_paper_map(ts, TABLE2_SCENARIOS),
+                "weights": _weights_label(weights),
                 "meaning": paper[0] if paper else "", "cost_own": r["cost"],
                 "cost_four": path_cost(equal.cost, [ts.index(t) for t in order]),
                 "paper_own": paper[1] if paper else None, "paper_four": paper[2] if paper else None,

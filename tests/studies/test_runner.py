@@ -102,7 +102,12 @@ def test_example_study_works_as_written(tmp_path):
     assert run.path == tmp_path / "out" / "small.jsonl"
     assert [(r["scenario"], r["method"], r["seed"]) for r in run.records] == [
         (s, m, seed) for s in ("random", "three_slit", "h_shape") for m, seed in (("dijkstra", None), ("htetro-ga", 0))]
-    assert _content(_lines(run.path)) == _content(run.records)
+    lines = _lines(run.path)  # the trials, and the exact reference of each scenario, which a gap needs
+    assert _content(r for r in lines if r["kind"] == "trial") == _content(run.records)
+    assert sorted(r["scenario"] for r in lines if r["kind"] == "reference") == ["h_shape", "random", "three_slit"]
+    for record in run.records:  # gaps by default; no plan beats the proven optimum
+        assert record["gap"] is None if not record["reached"] else record["gap"] >= 0
+        assert record["gap"] == 0 or record["method"] != "dijkstra"
     for record in run.records:  # the planner itself, called directly, is the oracle
         scenario = load_scenario(record["scenario"])
         options = {} if record["method"] == "dijkstra" else {"pop_size": 20, "max_gen": 3, "seed": 0}
@@ -239,7 +244,8 @@ def test_trial_key_hashes_the_inputs():
     b = run_trial("plan", "three_slit", "exact", {"clearance": 0.0}, None, label="dijkstra")
     c = run_trial("plan", "three_slit", "dijkstra", {}, None)
     assert a["key"] == b["key"] and a["key"] != c["key"]  # "exact" is dijkstra; an option given is an input
-    study = Study(name="k", task="plan", scenarios=["three_slit"], methods=[{"method": "dijkstra", "clearance": 0.0}])
+    study = Study(name="k", task="plan", scenarios=["three_slit"], methods=[{"method": "dijkstra", "clearance": 0.0}],
+                  metrics=())  # a metric asked for is an input of the key too
     assert study.trials()[0].key == a["key"]
 
 
@@ -325,6 +331,7 @@ name = "slow"
 task = "plan"
 scenarios = ["three_slit"]
 seeds = 14
+metrics = []                  # trials only: no exact reference among the lines counted
 [[methods]]
 method = "htetro-ga"
 pop_size = 16
@@ -368,7 +375,7 @@ def dying_trial(task, scenario, method, parameters, seed, *, label=None, metrics
 
 
 def test_lost_worker_process_stops_the_run_and_keeps_the_records(tmp_path):
-    study = Study(name="lost", task="plan", scenarios=["three_slit"], seeds=[0, 1],
+    study = Study(name="lost", task="plan", scenarios=["three_slit"], seeds=[0, 1], metrics=(),
                   methods=[{"method": "htetro-ga", "pop_size": 4, "max_gen": 2}])
     with pytest.raises(WorkerLost, match="resume continues the study"):
         run_study(study, out=tmp_path, executor="processes", workers=1, trial=dying_trial)
@@ -387,7 +394,8 @@ def test_seeds_override_and_unseeded_methods(tmp_path):
 
 
 def test_torn_last_line_is_dropped_on_resume(tmp_path):
-    study = Study(name="torn", task="plan", scenarios=["three_slit", "h_shape"], methods=[{"method": "dijkstra"}])
+    study = Study(name="torn", task="plan", scenarios=["three_slit", "h_shape"], methods=[{"method": "dijkstra"}],
+                  metrics=())
     first = run_study(study, out=tmp_path, executor="serial")
     text = first.path.read_text()
     lines = text.splitlines(keepends=True)
@@ -427,7 +435,7 @@ def failing_trial(task, scenario, method, parameters, seed, *, label=None, metri
 
 def test_failing_trial_is_recorded_and_the_study_goes_on(tmp_path):
     # tiling_8x7 tiles into 14 tiles: there is no tile 50 to start from, which only the trial finds out
-    study = Study(name="fail", task="sequence", scenarios=["tiling_8x7"],
+    study = Study(name="fail", task="sequence", scenarios=["tiling_8x7"], metrics=(),
                   methods=[{"method": "zigzag", "start": 50}, {"method": "zigzag2"}])
     notes = []
     run = run_study(study, out=tmp_path, executor="processes", workers=2,

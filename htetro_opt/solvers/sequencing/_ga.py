@@ -1,31 +1,39 @@
-"""The genetic algorithm of Le et al. 2018 for the waypoint order (§4, Algorithm 2) on DEAP, plain or memetic.
+"""The genetic algorithm of Le et al. 2018 for the waypoint order (§4, Algorithm 2) on DEAP, as published
+or with our additions.
 
 Algorithm 2 starts from random orders (population 60), selects parents, produces children, mutates
 them by swapping two random waypoints, *extends* the population with the best children and
-*reduces* it back. Here:
+*reduces* it back; "crossover is not included ... due to a similar waypoint re-visiting issue".
+Here, as published (``ga-plain``, ``additions=()``):
 
 - **individuals** (:class:`~htetro_opt.operators.permutation.Tour`) are permutations of the
   waypoints other than the start when the start is fixed (so every operator keeps it first), of all
   waypoints otherwise; the order is ``[start] + genes``;
-- **selection**: tournaments of ``tournament_size``
-  (:func:`~htetro_opt.operators.permutation.select_tournament`);
-- **children**: pairs of winners are crossed with probability ``crossover_rate`` by a linear order
-  crossover (:func:`~htetro_opt.operators.permutation.order_crossover`; the paper leaves crossover
-  out, ``crossover_rate=0`` restores that), then each child is mutated with probability
-  ``mutation_rate`` by the paper's swap (:func:`~htetro_opt.operators.permutation.swap_mutation`);
-- **extend and reduce** (elitist): parents and new children compete for the ``pop_size`` places;
-  an order already in the population takes no second place (unless there are too few distinct
-  ones). ``elite=e`` instead keeps the ``e`` best parents and fills the other places with the best
-  children (a comma strategy with elitism);
+- **selection**: tournaments of ``tournament_size`` (:func:`~htetro_opt.operators.permutation.select_tournament`;
+  the paper says only that cheaper orders have more chances to reproduce);
+- **children**: copies of the winners, each mutated with probability ``mutation_rate`` (1 for
+  ``ga-plain``: without crossover an unmutated child is its parent) by the paper's swap
+  (:func:`~htetro_opt.operators.permutation.swap_mutation`);
+- **extend and reduce** (elitist, our reading of "adding the best children ... reduce"): parents and
+  new children compete for the ``pop_size`` places. ``elite=e`` instead keeps the ``e`` best parents
+  and fills the other places with the best children (a comma strategy with elitism);
 - **stop** after ``max_gen`` generations, after ``patience`` generations without a better best
-  order, or at ``time_limit``.
+  order (the paper's "improvement of the current best solution"), or at ``time_limit``.
 
-``memetic=True`` (the ``ga`` method) also improves children by the compiled 2-opt/Or-opt local
-search of ``ils`` (:class:`~htetro_opt.solvers.sequencing._ils.LocalCore`: neighbour lists and
-don't-look bits, milliseconds per child where the earlier vectorised best-move search took seconds
-at 280+ waypoints and left the GA in its first generation) before they compete, checking the time
-budget between children; ``memetic=False`` (``ga-plain``) is the paper's GA as above. Neither seeds
-the population from a heuristic: it starts from random orders.
+Our additions (:data:`~htetro_opt.solvers.sequencing._spec.GA_ADDITIONS`, all on in ``ga``), each
+switched singly by ``additions``:
+
+- ``crossover``: pairs of winners are crossed with probability ``crossover_rate`` by a linear order
+  crossover (:func:`~htetro_opt.operators.permutation.order_crossover`), which keeps every waypoint once;
+- ``distinct``: in the reduction an order already in the population takes no second place (unless
+  there are too few distinct ones), so the population does not fill with copies of its best;
+- ``memetic``: the cheapest ``local_search_rate`` of each generation's new children are improved by the
+  compiled 2-opt/Or-opt local search of ``ils`` (:class:`~htetro_opt.solvers.sequencing._ils.LocalCore`:
+  neighbour lists and don't-look bits, milliseconds per child where the earlier vectorised best-move
+  search took seconds at 280+ waypoints and left the GA in its first generation) before they
+  compete, the time budget checked between children.
+
+Neither mode seeds the population from a heuristic: both start from random orders.
 
 All randomness comes from a private ``random.Random(derive_seed(seed))``: DEAP's own operators
 (``tools.cxOrdered``, ``tools.mutShuffleIndexes``, ``tools.selTournament``) draw from the global
@@ -45,12 +53,13 @@ import numpy as np
 from deap import base
 
 from htetro_opt._progress import check_progress, report
-from htetro_opt._validation import check_bool, check_int, check_probability, check_time_limit, derive_seed
+from htetro_opt._validation import check_int, check_probability, check_time_limit, derive_seed
 from htetro_opt.operators.permutation import Tour, order_crossover, select_tournament, swap_mutation
 from htetro_opt.problems.waypoint_sequencing import check_instance, path_cost
 from htetro_opt.solvers.sequencing._budgets import default_time_limit
 from htetro_opt.solvers.sequencing._ils import LocalCore
 from htetro_opt.solvers.sequencing._local import _check_cost, _tolerance
+from htetro_opt.solvers.sequencing._spec import SPEC
 
 __all__ = ["make_toolbox", "solve_ga"]
 
@@ -124,8 +133,13 @@ def _distinct(tours) -> tuple[list, list]:
     return firsts, repeats
 
 
-def _reduce(parents: list, children: list, size: int, elite: int | None) -> list:
+def _reduce(parents: list, children: list, size: int, elite: int | None, distinct: bool) -> list:
     """Extend the population with the children and reduce it to ``size`` (see the module doc)."""
+    if not distinct:  # the paper's: the cheapest, copies included (sorted is stable: parents first on ties)
+        if elite is None:
+            return sorted(parents + children, key=_cost_of)[:size]
+        keep = sorted(parents, key=_cost_of)[:elite]
+        return (keep + sorted(children, key=_cost_of))[:size]
     if elite is None:
         firsts, repeats = _distinct(parents + children)
         return (firsts + repeats)[:size]
@@ -136,12 +150,15 @@ def _reduce(parents: list, children: list, size: int, elite: int | None) -> list
     return (keep + firsts + rest + repeats)[:size]
 
 
-def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool = True,
-             pop_size: int = 60, max_gen: int = 2000, patience: int | None = 200,
-             crossover_rate: float = 0.8, mutation_rate: float = 0.2, tournament_size: int = 3,
-             elite: int | None = None, local_search_rate: float = 0.25,
+def solve_ga(instance, *, seed=0, time_limit: float | None = None,
+             additions=SPEC.default_of("ga", "additions"), pop_size: int = SPEC.default_of("ga", "pop_size"),
+             max_gen: int = SPEC.default_of("ga", "max_gen"), patience: int | None = SPEC.default_of("ga", "patience"),
+             crossover_rate: float = SPEC.default_of("ga", "crossover_rate"),
+             mutation_rate: float = SPEC.default_of("ga", "mutation_rate"),
+             tournament_size: int = SPEC.default_of("ga", "tournament_size"), elite: int | None = None,
+             local_search_rate: float = SPEC.default_of("ga", "local_search_rate"),
              progress=None) -> tuple[np.ndarray, dict]:
-    """Order the waypoints with the paper's GA (Algorithm 2), optionally memetic.
+    """Order the waypoints with the paper's GA (Algorithm 2), with the additions given (default ``ga``'s).
 
     Parameters
     ----------
@@ -154,8 +171,9 @@ def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool
     time_limit : float, optional
         Wall-clock budget in seconds; checked every generation (and between local-search rounds).
         None: 10 s + 1 s per 50 waypoints, at most 60 s.
-    memetic : bool
-        Improve children with the 2-opt/Or-opt local search before they compete.
+    additions : collection of str
+        Our additions switched on, of ``"crossover"``, ``"distinct"``, ``"memetic"`` (the module doc);
+        ``()`` with ``mutation_rate=1`` is the paper's GA (``ga-plain``).
     pop_size : int
         μ, the population (60 in the paper); also the number of children per generation.
     max_gen : int
@@ -163,7 +181,7 @@ def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool
     patience : int or None
         Stop after this many generations without a cheaper best order (None: never).
     crossover_rate : float
-        Probability that a pair of selected parents is crossed (0: the paper's mutation-only GA).
+        ``crossover`` only: the probability that a pair of selected parents is crossed.
     mutation_rate : float
         Probability that a child gets a swap mutation.
     tournament_size : int
@@ -172,7 +190,7 @@ def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool
         None: parents and children compete for every place ((μ+λ) reduction). An integer e: the e
         best parents survive and the other places go to the best children.
     local_search_rate : float
-        Memetic only: the share of each generation's new children (the cheapest first) that the
+        ``memetic`` only: the share of each generation's new children (the cheapest first) that the
         local search improves (each to its local optimum).
     progress : callable, optional
         ``progress(generation, max_gen, note)`` after every generation, the note giving the best cost.
@@ -183,7 +201,7 @@ def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool
         The best order found, starting at ``instance.start`` when it is set.
     info : dict
         ``generations``, ``evaluations`` (orders priced, initial population included),
-        ``memetic``, ``best_generation`` (when the best order was found; 0: the initial
+        ``additions``, ``best_generation`` (when the best order was found; 0: the initial
         population) and ``stopped`` (``"max_gen"``, ``"patience"`` or ``"time_limit"``).
 
     Raises
@@ -197,15 +215,16 @@ def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool
     >>> x = np.array([0.0, 5, 1, 4, 2, 3])
     >>> inst = SequencingInstance(np.abs(np.subtract.outer(x, x)), np.zeros((6, 4, 2)), start=0)
     >>> order, info = solve_ga(inst, seed=1, patience=20)
-    >>> order.tolist(), inst.path_cost(order), info["memetic"]
-    ([0, 2, 4, 5, 3, 1], 5.0, True)
-    >>> order, info = solve_ga(inst, memetic=False, seed=1, patience=50)
+    >>> order.tolist(), inst.path_cost(order), info["additions"]
+    ([0, 2, 4, 5, 3, 1], 5.0, ['crossover', 'distinct', 'memetic'])
+    >>> order, info = solve_ga(inst, additions=(), mutation_rate=1.0, seed=1, patience=50)
     >>> inst.path_cost(order)
     5.0
     """
     instance = check_instance(instance)
     rng = random.Random(derive_seed(seed))
-    memetic = check_bool(memetic, "memetic")
+    additions = SPEC.options["additions"].check(additions, "additions")
+    memetic, crossover, distinct = ("memetic" in additions, "crossover" in additions, "distinct" in additions)
     time_limit = check_time_limit(time_limit)
     if time_limit is None:
         time_limit = default_time_limit("ga" if memetic else "ga-plain", instance.n)
@@ -224,7 +243,7 @@ def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool
     deadline = began + time_limit
     toolbox = make_toolbox(instance, rng, tournament_size=tournament_size)
     fixed = instance.start is not None
-    info = {"generations": 0, "evaluations": 0, "memetic": memetic, "best_generation": 0,
+    info = {"generations": 0, "evaluations": 0, "additions": list(additions), "best_generation": 0,
             "stopped": "max_gen", "time_limit_s": time_limit}
     if instance.n - fixed <= 1:  # nothing to order
         pop = toolbox.population(1)
@@ -253,10 +272,11 @@ def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool
             break
         generation += 1
         offspring = [toolbox.clone(t) for t in toolbox.select(pop, pop_size)]
-        for a, b in zip(offspring[::2], offspring[1::2]):
-            if rng.random() < crossover_rate:
-                toolbox.mate(a, b)
-                del a.fitness.values, b.fitness.values
+        if crossover:
+            for a, b in zip(offspring[::2], offspring[1::2]):
+                if rng.random() < crossover_rate:
+                    toolbox.mate(a, b)
+                    del a.fitness.values, b.fitness.values
         for child in offspring:
             if rng.random() < mutation_rate:
                 toolbox.mutate(child)
@@ -265,7 +285,7 @@ def solve_ga(instance, *, seed=0, time_limit: float | None = None, memetic: bool
         evaluations += toolbox.evaluate(fresh)
         if memetic:
             local_search(fresh)
-        pop = _reduce(pop, offspring, pop_size, elite)
+        pop = _reduce(pop, offspring, pop_size, elite, distinct)
         leader = min(pop, key=_cost_of)
         report(progress, generation, max_gen, f"best cost {min(_cost_of(leader), _cost_of(best)):.4g}")
         if _cost_of(leader) < _cost_of(best) - tol:

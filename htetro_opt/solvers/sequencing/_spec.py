@@ -12,13 +12,14 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from htetro_opt._spec import Method, Option, Problem, TaskSpec, callback, choice, integer, real, seed_option
+from htetro_opt._spec import (Method, Option, Problem, TaskSpec, additions, callback, choice, integer, real,
+                              seed_option)
 from htetro_opt._validation import check_bool, check_int, check_real, check_time_limit
 from htetro_opt.errors import ParameterError
 from htetro_opt.solvers.sequencing._budgets import TIME_LIMIT_TEXT
 from htetro_opt.solvers.tiling._spec import shape_letters  # a scenario is tiled first: its shapes are the tiler's
 
-__all__ = ["SPEC", "is_tileset", "EXACT_AUTO_LIMIT", "EXACT_MAX_SIZE", "EXACT_TIME_LIMIT", "FAST_TSP_CANDIDATES",
+__all__ = ["SPEC", "is_tileset", "GA_ADDITIONS", "EXACT_AUTO_LIMIT", "EXACT_MAX_SIZE", "EXACT_TIME_LIMIT", "FAST_TSP_CANDIDATES",
            "FIRST_SOLUTIONS", "ILS_NEIGHBOURS"]
 
 EXACT_AUTO_LIMIT = 40
@@ -30,6 +31,16 @@ EXACT_MAX_SIZE = 40
 
 EXACT_TIME_LIMIT = 60.0
 """Default wall-clock budget of :func:`~htetro_opt.solvers.sequencing.solve_exact`, in seconds."""
+
+GA_ADDITIONS = {
+    "crossover": "pairs of selected parents are crossed by a linear order crossover (crossover_rate); the paper "
+                 "leaves crossover out, as it would revisit waypoints",
+    "distinct": "an order already in the population takes no second place when the population is reduced",
+    "memetic": "the cheapest share of each generation's children (local_search_rate) is improved by the compiled "
+               "2-opt/Or-opt local search of ils",
+}
+"""Our additions to Le et al. 2018's GA (Algorithm 2), by name: ``ga`` runs them all, ``ga-plain`` (the
+paper's) none; each is switched on or off by the ``additions`` option (docs/papers/le2018.md)."""
 
 ILS_NEIGHBOURS = 8
 """Size of each node's neighbour (candidate) list in ``ils``."""
@@ -115,12 +126,15 @@ OPTIONS = (
     Option("max_gen", integer(0), "generations at most", default=2000, flag=""),
     Option("patience", integer(1, none=True), "generations without improvement before stopping", default=200,
            flag=""),
-    Option("crossover_rate", real(0.0, 1.0), "ordered-crossover rate", default=0.8, flag=""),
-    Option("mutation_rate", real(0.0, 1.0), "swap-mutation rate", default=0.2, flag=""),
+    Option("additions", additions(GA_ADDITIONS), "the GA's additions of ours switched on: all, none, or some of "
+           f"{', '.join(GA_ADDITIONS)} (docs/papers/le2018.md)", metavar="NAMES"),
+    Option("crossover_rate", real(0.0, 1.0), "order-crossover rate (the crossover addition)", default=0.8, flag=""),
+    Option("mutation_rate", real(0.0, 1.0), "share of the children mutated by the paper's swap", default=0.2,
+           flag=""),
     Option("tournament_size", integer(1), "tournament size", default=3, flag=""),
-    Option("elite", integer(0, none=True), "individuals kept unchanged each generation", flag="",
-           default_text="a tenth of the population"),
-    Option("local_search_rate", real(0.0, 1.0), "share of offspring improved by 2-opt/Or-opt",
+    Option("elite", integer(0, none=True), "the e best parents kept, the other places to the best children", flag="",
+           default_text="none: parents and children compete for every place"),
+    Option("local_search_rate", real(0.0, 1.0), "share of offspring improved by 2-opt/Or-opt (the memetic addition)",
            default=0.25, flag=""),
     Option("iterations", integer(1), "random restarts of the greedy search", default=10_000, flag=""),
     Option("scale", real(0.0, above=True, none=True),
@@ -135,8 +149,9 @@ OPTIONS = (
 )
 
 _PAPER = "Le et al. 2018"
-_GA = ("seed", "time_limit", "progress", "pop_size", "max_gen", "patience", "crossover_rate", "mutation_rate",
-       "tournament_size", "elite")
+_GA = ("seed", "time_limit", "progress", "additions", "pop_size", "max_gen", "patience", "crossover_rate",
+       "mutation_rate", "tournament_size", "elite", "local_search_rate")
+_PARAMETERS = {"crossover": "crossover_rate", "memetic": "local_search_rate"}  # addition -> the option it uses
 _PATTERN = dict(capabilities={"asymmetric", "geometry"}, origin="baseline", paper=_PAPER, family=("pattern",))
 
 METHODS = (
@@ -154,11 +169,14 @@ METHODS = (
            seeded=lambda options: options.get("restarts", 0) > 0, capabilities={"progress"}),
     Method("ils", "._ils:solve_ils", "the compiled, seeded iterated local search (2-opt, Or-opt, double-bridge "
            "kicks)", ("seed", "time_limit", "kicks", "neighbours"), seeded=True, capabilities={"tours", "implicit"}),
-    Method("ga", "._ga:solve_ga", "the paper's GA on DEAP with a 2-opt/Or-opt step (memetic, ours)",
-           (*_GA, "local_search_rate"), defaults={"patience": 50}, presets={"memetic": True}, seeded=True,
-           paper=_PAPER, family=("ga",), capabilities={"progress"}),
-    Method("ga-plain", "._ga:solve_ga", "the paper's GA on DEAP", _GA, presets={"memetic": False}, seeded=True,
-           origin="paper", paper=_PAPER, family=("ga",), capabilities={"progress"}),
+    Method("ga", "._ga:solve_ga", "the paper's GA on DEAP with our additions (order crossover, distinct "
+           "survivors, a 2-opt/Or-opt step)", _GA, defaults={"additions": tuple(GA_ADDITIONS), "patience": 50},
+           seeded=True, origin="ours", paper=_PAPER, family=("ga",), capabilities={"progress"}),
+    # Algorithm 2 as published: no crossover ("not included ... due to a similar waypoint re-visiting
+    # issue"), so every child is its parent with two random waypoints swapped
+    Method("ga-plain", "._ga:solve_ga", "the paper's GA on DEAP, as published (swap mutation, no crossover)", _GA,
+           defaults={"additions": (), "mutation_rate": 1.0}, seeded=True, origin="paper", paper=_PAPER,
+           family=("ga",), capabilities={"progress"}),
     Method("zigzag", "._baselines:solve_zigzag", "the paper's zigzag, one row", presets={"rows": 1}, **_PATTERN),
     Method("zigzag2", "._baselines:solve_zigzag", "the paper's zigzag, two rows", presets={"rows": 2}, **_PATTERN),
     Method("spiral", "._baselines:solve_spiral", "the paper's spiral, one row", presets={"rows": 1}, **_PATTERN),
@@ -256,10 +274,21 @@ def _source(source):
     return "tileset", load_tileset(tileset_path(source))
 
 
+def _relations(method: Method, given: dict, label) -> None:
+    """A rate given for an addition that is off is refused (it would change nothing)."""
+    if not method.takes("additions"):
+        return
+    on = given.get("additions", method.defaults.get("additions", ()))
+    for addition, option in _PARAMETERS.items():
+        if option in given and addition not in on:
+            raise ParameterError(f"{label(option)} sets the {addition} addition, which is off in {method.name}: "
+                                 f"switch it on with {label('additions')} (e.g. {addition})")
+
+
 SPEC = TaskSpec(
     "sequencing", package="htetro_opt.solvers.sequencing", entry="._dispatch:sequence_waypoints", options=OPTIONS,
     methods=METHODS, default="auto", exact="exact",
     families={"ga": "the GA methods", "pattern": "the pattern baselines"},
-    common=tuple(option.name for option in OPTIONS if option.stage == "problem"), pose=_pose,
+    common=tuple(option.name for option in OPTIONS if option.stage == "problem"), relations=_relations, pose=_pose,
 )
 """The sequencing task (see the module docstring)."""

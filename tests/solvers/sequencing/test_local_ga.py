@@ -28,6 +28,7 @@ from htetro_opt.solvers.sequencing import (
 )
 
 TOL = 1e-9
+PAPER = {"additions": (), "mutation_rate": 1.0}  # ga-plain's defaults: Le et al. 2018's Algorithm 2 as published
 
 
 # ------------------------------------------------------------------------------------ helpers
@@ -280,21 +281,21 @@ def test_solvers_reach_the_exact_optimum_on_small_instances(gen, n, seed, start)
     assert info["restarts"] == 30 and info["local_optimum_cost"] >= path_cost(cost, local) - TOL
     memetic, info = solve_ga(inst, seed=seed, patience=30)
     assert path_cost(cost, inst.check_order(memetic)) == pytest.approx(best, abs=1e-9)
-    assert info["memetic"] is True and info["generations"] >= 1
-    # the paper's GA, without local search, also finds these small optima (30 stale generations)
-    plain, info = solve_ga(inst, seed=seed, memetic=False, patience=30)
-    assert path_cost(cost, inst.check_order(plain)) == pytest.approx(best, abs=1e-9)
-    assert info["memetic"] is False
+    assert info["additions"] == ["crossover", "distinct", "memetic"] and info["generations"] >= 1
+    # the paper's GA (swaps only, copies kept) may stall above these optima after 30 stale generations
+    plain, info = solve_ga(inst, seed=seed, **PAPER, patience=30)
+    assert path_cost(cost, inst.check_order(plain)) >= best - TOL
+    assert info["additions"] == []
     assert info["evaluations"] >= 60 and 0 <= info["best_generation"] <= info["generations"]
 
 
 def test_plain_ga_finds_the_optimum_of_a_tiny_instance_and_reports_its_stop():
     cost = euclidean(6, 8)
     inst = instance(cost, 2)
-    order, info = solve_ga(inst, memetic=False, seed=3, patience=100)
+    order, info = solve_ga(inst, **PAPER, seed=3, patience=100)
     assert path_cost(cost, order) == pytest.approx(brute_optimum(cost, 2))
     assert info["stopped"] == "patience"
-    _, info = solve_ga(inst, memetic=False, max_gen=5, patience=None)
+    _, info = solve_ga(inst, **PAPER, max_gen=5, patience=None)
     assert info["generations"] == 5 and info["stopped"] == "max_gen"
 
 
@@ -320,9 +321,9 @@ def test_ga_options_are_checked_and_named():
 def test_elitist_comma_variant_and_time_limit():
     cost = euclidean(12, 6)
     inst = instance(cost, 0)
-    order, info = solve_ga(inst, memetic=False, elite=5, seed=1, max_gen=300)
+    order, info = solve_ga(inst, **PAPER, elite=5, seed=1, max_gen=300)
     assert is_permutation(order, 12) and order[0] == 0
-    order, info = solve_ga(inst, memetic=False, max_gen=10**9, patience=None, time_limit=0.3)
+    order, info = solve_ga(inst, **PAPER, max_gen=10**9, patience=None, time_limit=0.3)
     assert info["stopped"] == "time_limit" and is_permutation(order, 12)
 
 
@@ -336,7 +337,7 @@ def test_same_seed_same_order_and_global_random_states_untouched():
     creator_names = set(vars(creator))
     runs = {}
     for key, run in [("ga", lambda s: solve_ga(inst, seed=s, patience=20)),
-                     ("plain", lambda s: solve_ga(inst, seed=s, memetic=False, patience=40)),
+                     ("plain", lambda s: solve_ga(inst, seed=s, **PAPER, patience=40)),
                      ("local", lambda s: solve_local(inst, seed=s, restarts=15))]:
         runs[key] = [run(s)[0].tolist() for s in (7, 7, 8)]
         assert runs[key][0] == runs[key][1]
@@ -360,7 +361,7 @@ def test_dispatcher_runs_ga_ga_plain_and_local():
         assert result.tiles[0] == 3 and sorted(result.tiles) == list(range(1, 8))
         assert result.cost == pytest.approx(eq2_cost(ts, result.tiles))
     assert results["ga"].cost == pytest.approx(8.0) and results["local"].cost == pytest.approx(8.0)
-    assert results["ga"].info["memetic"] is True and results["ga-plain"].info["memetic"] is False
+    assert results["ga"].additions == ("crossover", "distinct", "memetic") and results["ga-plain"].additions == ()
     assert sequence_waypoints(inst, method="ga", time_limit=5, patience=5).method == "ga"
 
 
@@ -376,3 +377,51 @@ def test_memetic_ga_keeps_its_time_budget_on_300_waypoints():
     assert is_permutation(order, 300) and order[0] == 0
     assert info["stopped"] == "time_limit" and spent < 2.0 + 1.0
     assert info["generations"] > 1
+
+
+# ------------------------------------------------------------------ ga-plain is Algorithm 2 as published
+def _spy(monkeypatch, name):
+    """Count the calls of the GA module's ``name`` (an operator or helper), still running it."""
+    from htetro_opt.solvers.sequencing import _ga
+
+    calls = []
+    real = getattr(_ga, name)
+
+    def spy(*args, **kwargs):
+        calls.append(1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(_ga, name, spy)
+    return calls
+
+
+def test_ga_plain_never_crosses_and_swaps_every_child(monkeypatch):
+    inst = SequencingInstance.from_tileset(parse_tileset("\n".join(f"{i}a {i}b {i}c {i}d" for i in range(1, 13))),
+                                           start=1)
+    crossed, swapped = _spy(monkeypatch, "order_crossover"), _spy(monkeypatch, "swap_mutation")
+    distinct = _spy(monkeypatch, "_distinct")
+    result = sequence_waypoints(inst, method="ga-plain", seed=2, max_gen=7, patience=None)
+    assert result.info["generations"] == 7 and result.additions == ()
+    assert not crossed and not distinct  # "crossover is not included"; copies compete like any order
+    assert len(swapped) == 7 * 60  # each of the 60 children of each generation gets the paper's swap
+    ours = sequence_waypoints(inst, method="ga", seed=2, max_gen=7, patience=None)
+    assert crossed and distinct and ours.additions == ("crossover", "distinct", "memetic")
+
+
+@pytest.mark.parametrize("addition", ["crossover", "distinct", "memetic"])
+def test_each_ga_addition_switches_alone(monkeypatch, addition):
+    inst = instance(euclidean(15, 4), 0)
+    operator = {"crossover": "order_crossover", "distinct": "_distinct", "memetic": "LocalCore"}[addition]
+    calls = _spy(monkeypatch, operator)
+    result = sequence_waypoints(inst, method="ga-plain", additions=[addition], seed=0, max_gen=3, patience=None)
+    assert result.additions == (addition,) and calls
+    assert sequence_waypoints(inst, method="ga-plain", additions=[addition], seed=0, max_gen=3,
+                              patience=None).order.tolist() == result.order.tolist()  # seeded: the same again
+
+
+def test_a_rate_for_an_addition_that_is_off_is_refused():
+    inst = instance(euclidean(6, 0))
+    with pytest.raises(ParameterError, match="crossover_rate sets the crossover addition, which is off in ga-plain"):
+        sequence_waypoints(inst, method="ga-plain", crossover_rate=0.5)
+    with pytest.raises(ParameterError, match="local_search_rate sets the memetic addition"):
+        sequence_waypoints(inst, method="ga", additions=["crossover"], local_search_rate=0.5)
