@@ -88,3 +88,21 @@ def test_every_method_is_in_the_synopsis():
             if "--method" in action.option_strings:
                 missing = {c for c in action.choices if (command, c) not in listed}
                 assert not missing, f"{command} --method {missing} missing from the README"
+
+
+def _relative_links(text):
+    for target in re.findall(r"\]\(([^)\s]+)\)", text):
+        if not re.match(r"[a-z]+:", target):  # http:, https:, mailto:
+            yield target.split("#", 1)[0]
+
+
+@pytest.mark.parametrize("page", ["README.md", *sorted(str(p.relative_to(ROOT)) for p in (ROOT / "docs").rglob("*.md"))])
+def test_every_relative_link_leads_to_a_file(page):
+    source = ROOT / page
+    missing = [t for t in _relative_links(source.read_text(encoding="utf-8")) if t and not (source.parent / t).exists()]
+    assert not missing, f"{page} links to {missing}"
+
+
+def test_the_readme_stays_short():
+    words = len(re.findall(r"\S+", README))
+    assert words <= 2500, f"README.md has {words} words: details belong in docs/ and benchmarks/README.md"

@@ -23,6 +23,22 @@ _PREFIX = "opt_"  # argparse destinations of the specs' options, apart from the 
 
 
 # --- options from the specs -------------------------------------------------------------------------
+def whole_number(text: str) -> int:
+    """A count as a user types it: ``100``, ``100_000`` or ``1e5`` (so that ``--pop-size 1e9`` meets the
+    option's own bound, which says what that many would cost, rather than a parse error)."""
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        value = float(text)
+    except ValueError:
+        value = None
+    if value is None or not value.is_integer():
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}")
+    return int(value)
+
+
 def add_method(parser: argparse.ArgumentParser, specs: Mapping[str, TaskSpec], *, extra: str = "") -> None:
     """``--method``: the choices of every spec, its help their summaries (default: the spec's default)."""
     names = list(dict.fromkeys(name for spec in specs.values() for name in spec.names))
@@ -58,7 +74,8 @@ def add_task_options(parser: argparse.ArgumentParser, specs: Mapping[str, TaskSp
                 group.add_argument(option.off_flag, dest=dest, action="store_const", const=False, default=None,
                                    help=text if not option.flag else argparse.SUPPRESS)
         else:
-            parser.add_argument(option.flag, dest=dest, type=option.type, choices=option.choices,
+            kind = whole_number if option.type is int else option.type
+            parser.add_argument(option.flag, dest=dest, type=kind, choices=option.choices,
                                 metavar=option.metavar, default=None, help=text)
 
 

@@ -24,6 +24,11 @@ __all__ = ["add_parser", "run"]
 _SPECS = {"grid scenarios": GRID_PATHS, "continuous scenarios": CONTINUOUS}
 
 
+def _seconds(time: float) -> str:
+    """A plan's time for a title: 33, 45.9 (diagonal moves make times like 45.8855 s)."""
+    return f"{time:.1f}".rstrip("0").rstrip(".")
+
+
 def add_parser(sub) -> None:
     p = sub.add_parser("plan", help="plan a path through a scenario's roadmap",
                        description="Plan the robot's commands through a grid scenario's roadmap (start, "
@@ -69,15 +74,15 @@ def _only(flag: str, where: str):
 def _grid(args, problem, plan, out: dict, shown) -> dict:
     scenario = problem.scenario
     genetic = bool(plan.legs)
+    if plan.reached:
+        status = f"time {_seconds(plan.time)} s, {len(plan.tokens)} commands, reached"
+    else:
+        status = (f"goal NOT reached (leg {plan.failed_leg + 1} {'not solved' if genetic else 'has no path'}; "
+                  f"{len(plan.tokens)} commands of the legs before it)")
+    title = f"{scenario.name}: {plan.method}, {status}"  # the figure and the animation say the same
     if args.plot:
         from htetro_opt.viz import plot_ga_plan, plot_path
 
-        if plan.reached:
-            status = f"time {plan.time:g} s, {len(plan.tokens)} commands, reached"
-        else:
-            status = (f"goal NOT reached (leg {plan.failed_leg + 1} {'not solved' if genetic else 'has no path'}; "
-                      f"{len(plan.tokens)} commands of the legs before it)")
-        title = f"{scenario.name}: {plan.method}, {status}"
         if genetic:
             def figure():
                 return plot_ga_plan(scenario.workspace, plan, roadmap=scenario.roadmap, hidden=scenario.hidden,
@@ -94,7 +99,6 @@ def _grid(args, problem, plan, out: dict, shown) -> dict:
                                  title=title)
         late(out, lambda: save_plot(shown, figure, args.plot))
     if args.gif:
-        title = f"{scenario.name}: {plan.method}, time {plan.time:g} s"
         late(out, lambda: save_gif(shown, scenario.workspace, plan.commands, scenario.roadmap[0],
                                    roadmap=scenario.roadmap, hidden=scenario.hidden, title=title, path=args.gif))
     if not args.json:
