@@ -64,6 +64,8 @@ and its best time stays well above the exact optimum; the additions fix both.
 
 from __future__ import annotations
 
+import time as _time
+
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.individual import Individual
@@ -487,7 +489,13 @@ class HTetroGA(GeneticAlgorithm):
         if not members.reached.any():
             return
         row = select_solutions(members.F)["multi_objective"]
-        polished = polish_sum(self.problem, members.X[row], window=self.polish_window)
+        deadline = getattr(self.termination, "deadline", None)  # a run's time limit bounds the polish too
+        if deadline is not None and _time.perf_counter() >= deadline:
+            self.data["time_limited"] = True  # no time left: the run ends unpolished
+            return
+        polished = polish_sum(self.problem, members.X[row], window=self.polish_window, deadline=deadline)
+        if deadline is not None and _time.perf_counter() >= deadline:
+            self.data["time_limited"] = True  # cut inside the polish: its result depends on the machine's speed
         if polished is members.X[row]:
             return  # nothing improved
         outcomes = self.problem.outcomes(self.problem.simulate([polished]))

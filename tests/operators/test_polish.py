@@ -138,6 +138,18 @@ def test_deterministic_and_the_input_back_when_nothing_to_do(legs):
     assert polish_sum(problem, optimum) is optimum
 
 
+def test_a_deadline_already_passed_stops_the_polish_before_any_window(legs):
+    """A run's time limit bounds the polish: with its deadline in the past (0, a ``perf_counter`` value
+    no run reaches again) no window length is tried and the input comes back, though the same path
+    polishes to a larger sum without one."""
+    problem, _, paths = legs["6x6 one obstacle"]
+    improvable = [path for path in paths if polish_sum(problem, path, window=40) is not path]
+    assert improvable
+    for path in improvable:
+        assert polish_sum(problem, path, window=40, deadline=0.0) is path
+        assert polish_sum(problem, path, window=2, deadline=0.0) is path
+
+
 @pytest.mark.parametrize("keyword, value, match", [
     ("window", -1, "polish_window"), ("window", 2.5, "polish_window"), ("span", -1, "span"),
     ("max_rounds", 0, "max_rounds"),

@@ -32,6 +32,7 @@ member gives the same result.
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 
@@ -124,10 +125,13 @@ class _Leg:
 
 
 def _window(leg: _Leg, local: np.ndarray, poses: np.ndarray, i: int, j: int, current: float,
-            span: int | None) -> tuple[np.ndarray, float] | None:
+            span: int | None, deadline: float | None = None) -> tuple[np.ndarray, float] | None:
     """The best replacement of the window [i, j) of the path (local command ids ``local``, poses
     ``poses`` from the start), simulated: the new path's global ids and its sum, or None when no
-    candidate sums more than ``current``."""
+    candidate sums more than ``current``. Past ``deadline`` (a ``time.perf_counter`` value) no further
+    length is tried: the candidates found by then are the ones simulated."""
+    if deadline is not None and time.perf_counter() >= deadline:
+        return None
     problem, sim = leg.problem, leg.sim
     l = len(local)
     start, end = int(poses[i]), int(poses[j])
@@ -156,6 +160,8 @@ def _window(leg: _Leg, local: np.ndarray, poses: np.ndarray, i: int, j: int, cur
         ceiling = 4.0 - (fixed_time + m * leg.shortest) * w_time
         if ceiling <= best + _IMPROVEMENT:
             break
+        if deadline is not None and time.perf_counter() >= deadline:
+            break  # a run's time limit: the lengths tried so far give the candidates
         bracket, _ = leg.solve(start, start_command, end, end_command, phase0, m, total_length, None)
         if bracket == np.inf:
             continue
@@ -177,7 +183,7 @@ def _window(leg: _Leg, local: np.ndarray, poses: np.ndarray, i: int, j: int, cur
 
 
 def polish_sum(problem: CommandPathProblem, sequence, *, window: int = POLISH_WINDOW, span: int | None = POLISH_SPAN,
-               max_rounds: int = POLISH_ROUNDS) -> np.ndarray:
+               max_rounds: int = POLISH_ROUNDS, deadline: float | None = None) -> np.ndarray:
     """A goal-reaching chromosome with windows of its path re-planned for the largest fitness sum.
 
     See the module docstring for the method. Deterministic: no random numbers are drawn.
@@ -203,6 +209,10 @@ def polish_sum(problem: CommandPathProblem, sequence, *, window: int = POLISH_WI
     max_rounds : int, keyword-only
         The most rounds of windows over a path longer than W (a round ends the polish when it
         improves nothing).
+    deadline : float, optional, keyword-only
+        A ``time.perf_counter()`` value (a run's time limit): past it no further window length is
+        tried and no further window started; what was found by then is returned (the polish then
+        depends on the machine's speed). None: no limit.
 
     Returns
     -------
@@ -260,13 +270,13 @@ def polish_sum(problem: CommandPathProblem, sequence, *, window: int = POLISH_WI
             whole = l <= window
             i = 0 if whole else min(start, l - window)
             j = l if whole else i + window
-            found = _window(leg, local, poses, i, j, current, None if whole else span)
+            found = _window(leg, local, poses, i, j, current, None if whole else span, deadline)
             if found is not None:
                 path, current = found
                 improved = round_improved = True
-            if whole or j >= l:
+            if whole or j >= l or (deadline is not None and time.perf_counter() >= deadline):
                 break
             start = i + max(1, window // 2)
-        if not round_improved or whole:
+        if not round_improved or whole or (deadline is not None and time.perf_counter() >= deadline):
             break  # a whole-path window is exact: a second round would find nothing
     return path if improved else given
