@@ -4,6 +4,7 @@ A grid scenario::
 
     name = "three_slit"
     source = "Cheng et al. 2020, Fig. 9d (reconstructed)"
+    licence = "BSD-3-Clause"       # optional: the terms of a map taken from elsewhere
     description = "..."            # optional
     cell_size_m = 0.25             # optional, d_grid in metres
     grid = '''
@@ -51,13 +52,17 @@ from htetro_opt.scenarios.rosmap import load_ros_map
 __all__ = ["Scenario", "ContinuousScenario", "check_continuous_scenario", "load_scenario_file", "parse_scenario",
            "parse_grid", "format_grid"]
 
-_GRID_KEYS = {"name", "source", "description", "cell_size_m", "grid", "map", "roadmap", "moving", "hidden"}
-_CONTINUOUS_KEYS = {"name", "source", "description", "width", "height", "obstacles", "robot_radius", "robots"}
+_GRID_KEYS = {"name", "source", "licence", "description", "cell_size_m", "grid", "map", "roadmap", "moving", "hidden"}
+_CONTINUOUS_KEYS = {"name", "source", "licence", "description", "width", "height", "obstacles", "robot_radius", "robots"}
 
 
 @dataclass(frozen=True, eq=False)  # holds arrays: identity equality, hashable
 class Scenario:
-    """A grid environment with its roadmap (first configuration = start, last = goal)."""
+    """A grid environment with its roadmap (first configuration = start, last = goal).
+
+    ``source`` says where the layout comes from and ``licence`` under which terms it may be used and
+    shared (empty for our own reconstructions, which the package's licence covers).
+    """
 
     name: str
     source: str
@@ -66,6 +71,7 @@ class Scenario:
     description: str = ""
     hidden: np.ndarray = field(default_factory=lambda: np.empty((0, 2), dtype=np.int64))
     path: Path | None = None
+    licence: str = ""
 
     @property
     def start(self) -> Pose | None:
@@ -108,6 +114,7 @@ class ContinuousScenario:
     goals: np.ndarray
     description: str = ""
     path: Path | None = None
+    licence: str = ""
 
     @property
     def n_robots(self) -> int:
@@ -138,7 +145,7 @@ class ContinuousScenario:
         geometry = _continuous_geometry(self.width, self.height, self.obstacles, radius, self.name)
         _check_robots(geometry, self.starts, self.goals, self.name)
         return ContinuousScenario(self.name, self.source, self.width, self.height, self.obstacles, radius,
-                                  self.starts, self.goals, self.description, self.path)
+                                  self.starts, self.goals, self.description, self.path, self.licence)
 
     @classmethod
     def from_grid(cls, scenario: Scenario, *, robot_radius=0.0) -> ContinuousScenario:
@@ -185,7 +192,7 @@ class ContinuousScenario:
         _check_robots(geometry, starts, goals, scenario.name)
         source = f"{scenario.source} (as a continuous workspace)" if scenario.source else "a grid scenario"
         return cls(scenario.name, source, width, height, tuple(obstacles), radius, starts, goals,
-                   scenario.description, scenario.path)
+                   scenario.description, scenario.path, scenario.licence)
 
 
 def check_continuous_scenario(scenario) -> ContinuousScenario:
@@ -274,9 +281,9 @@ def _require(table: dict, key: str, kinds, where: str):
     return value
 
 
-def _header(data: dict, allowed: set[str], where: str, default_name: str | None) -> tuple[str, str, str]:
-    """Check a scenario's keys; its name (``default_name``, the file's stem, when absent), source and
-    description (both optional: a user's own map needs no bookkeeping)."""
+def _header(data: dict, allowed: set[str], where: str, default_name: str | None) -> tuple[str, str, str, str]:
+    """Check a scenario's keys; its name (``default_name``, the file's stem, when absent), source,
+    description and licence (all optional: a user's own map needs no bookkeeping)."""
     unknown = set(data) - allowed
     if unknown:
         raise ScenarioError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
@@ -285,12 +292,12 @@ def _header(data: dict, allowed: set[str], where: str, default_name: str | None)
     else:
         name = default_name
     texts = []
-    for key in ("source", "description"):
+    for key in ("source", "description", "licence"):
         value = data.get(key, "")
         if not isinstance(value, str):
             raise ScenarioError(f"{where}: {key!r} must be a string, got {type(value).__name__}")
         texts.append(value)
-    return name, texts[0], texts[1]
+    return name, texts[0], texts[1], texts[2]
 
 
 def _array(data: dict, key: str, where: str, *, tables: bool = False) -> list:
@@ -388,7 +395,7 @@ def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = N
                             f"got {type(data).__name__} {reprlib.repr(data)}")
     if "grid" not in data and "map" not in data and ("width" in data or "robots" in data):
         return _parse_continuous(data, where=where, base=base, default_name=default_name)
-    name, source, description = _header(data, _GRID_KEYS, where, default_name)
+    name, source, description, licence = _header(data, _GRID_KEYS, where, default_name)
     if ("grid" in data) == ("map" in data):
         raise ScenarioError(f"{where}: give exactly one of 'grid' (text rows) or 'map' (a ROS map YAML)")
     cell_size = None
@@ -442,7 +449,7 @@ def parse_scenario(data: dict, *, where: str = "scenario", base: Path | None = N
             revealed[hidden[:, 1], hidden[:, 0]] = True
             _check_pose_on_map(pose, Workspace(revealed), f"{at} (against the hidden obstacles)")
         roadmap.append(pose)
-    return Scenario(name, source, workspace, tuple(roadmap), description, hidden, base)
+    return Scenario(name, source, workspace, tuple(roadmap), description, hidden, base, licence)
 
 
 def _continuous_geometry(width, height, obstacles, radius, where):
@@ -481,7 +488,7 @@ def _check_robots(geometry, starts: np.ndarray, goals: np.ndarray, where: str) -
 def _parse_continuous(data: dict, *, where: str, base: Path | None, default_name: str | None = None) -> ContinuousScenario:
     from htetro_opt.model.continuous import as_polygon
 
-    name, source, description = _header(data, _CONTINUOUS_KEYS, where, default_name)
+    name, source, description, licence = _header(data, _CONTINUOUS_KEYS, where, default_name)
     width = _number(data, "width", where, minimum=0.0, include_minimum=False)
     height = _number(data, "height", where, minimum=0.0, include_minimum=False)
     radius = _number(data, "robot_radius", where, default=0.0, minimum=0.0)
@@ -512,7 +519,7 @@ def _parse_continuous(data: dict, *, where: str, base: Path | None, default_name
     starts, goals = np.array(points["start"]), np.array(points["goal"])
     _check_robots(geometry, starts, goals, where)
     scenario = ContinuousScenario(name, source, width, height, tuple(obstacles), radius, starts, goals,
-                                  description, base)
+                                  description, base, licence)
     scenario.__dict__["geometry"] = geometry  # built for the checks: the cached property's value
     return scenario
 
