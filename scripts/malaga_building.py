@@ -102,9 +102,7 @@ def convert(gridmap: Path, out_dir: Path, factor: int = FACTOR) -> dict:
         "free_thresh: 0.196\n",
         encoding="utf-8",
     )
-    return {"gridmap_sha256": hashlib.sha256(gzip.decompress(gridmap.read_bytes())
-                                             if gridmap.read_bytes()[:2] == b"\x1f\x8b" else gridmap.read_bytes()).hexdigest(),
-            "source_pixels": cells.shape[::-1], "source_resolution": resolution,
+    return {"gridmap_sha256": hashlib.sha256(gridmap.read_bytes()).hexdigest(), "source_pixels": cells.shape[::-1], "source_resolution": resolution,
             "crop_pixels": (x0, y0, w * factor, h * factor), "bundled_size": (w, h), "resolution": cell,
             "origin": origin}
 

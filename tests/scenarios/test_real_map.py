@@ -14,8 +14,9 @@ import pytest
 import yaml
 from PIL import Image
 
+from htetro_opt.errors import ScenarioError
 from htetro_opt.model import Simulator
-from htetro_opt.scenarios import list_scenarios, load_ros_map, load_scenario, scenario_path
+from htetro_opt.scenarios import ContinuousScenario, list_scenarios, load_ros_map, load_scenario, parse_scenario, scenario_path
 from htetro_opt.solvers.grid_paths import plan_exact
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -154,3 +155,16 @@ def test_a_plan_across_the_hall_revalidates_and_is_no_slower_than_the_o_shape_al
     assert plan.time <= oracle  # the exact optimum over all commands never loses to translations alone
     manhattan = abs(scenario.goal.x - scenario.start.x) + abs(scenario.goal.y - scenario.start.y)
     assert oracle >= manhattan  # the oracle itself: one cell a translation
+
+
+def test_a_licence_is_optional_text_and_survives_conversion():
+    grid = {"name": "g", "grid": "....\n....\n....", "licence": "CC-BY-4.0"}
+    assert parse_scenario(grid).licence == "CC-BY-4.0"
+    assert parse_scenario({k: v for k, v in grid.items() if k != "licence"}).licence == ""
+    with pytest.raises(ScenarioError, match="'licence' must be a string, got int"):
+        parse_scenario({**grid, "licence": 3})
+    field = {"name": "c", "licence": "CC0-1.0", "width": 4.0, "height": 4.0,
+             "robots": [{"start": [1.0, 1.0], "goal": [3.0, 3.0]}]}
+    assert parse_scenario(field).licence == "CC0-1.0"
+    # a grid map taken as a continuous workspace keeps its terms
+    assert ContinuousScenario.from_grid(load_scenario(NAME)).licence == load_scenario(NAME).licence
