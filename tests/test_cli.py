@@ -1072,7 +1072,8 @@ def test_cover_json_keys_and_replay(capsys):
     paper = run_json(capsys, ["cover", "coverage_16x7", "--shapes", "O,hI", "--stripes", "2,3,2", "--method",
                               "stripes-paper", "--json"])
     assert paper["stripes_detail"][-1]["borrowed"] >= 1  # the paper's Fig. 11: the top stripe borrows a row
-    assert out["action_cost"] <= paper["action_cost"]
+    assert paper["additions"] == [] and paper["mopup_commands"] == 0
+    assert paper["success"] is (not paper["missed"] and not paper["failed_regions"])
 
 
 def test_cover_boustrophedon_and_auto_start(capsys):
@@ -1082,8 +1083,9 @@ def test_cover_boustrophedon_and_auto_start(capsys):
     assert stripes["goal"] is None and bous["method"] == "boustrophedon"
     code, out, err = run(capsys, ["cover", "coverage_16x7", "--start", "auto", "--shapes", "O,hI"])
     assert code == 0 and "commands" in out.splitlines()[0]
-    for method in ("stripes-paper", "tiling-tsp"):
-        other = run_json(capsys, ["cover", "coverage_16x16", "--method", method, "--shapes", "O,vI,hI", "--json"])
+    for method, more in (("stripes-paper", ["--additions", "greedy-fallback,mopup"]), ("tiling-tsp", [])):
+        other = run_json(capsys, ["cover", "coverage_16x16", "--method", method, "--shapes", "O,vI,hI", *more,
+                                  "--json"])
         assert other["complete"] and other["method"] == method and other["action_cost"] > stripes["action_cost"]
 
 

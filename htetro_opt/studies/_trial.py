@@ -280,10 +280,10 @@ def _cover_record(problem, plan, method, parameters, metrics) -> tuple[dict, dic
     cost = plan.action_cost
     out = {"action_cost": cost, "time": plan.time, "complete": plan.complete, "free": fields["free"],
            "coverable": coverable, "covered": fields["covered"], "uncoverable": len(plan.uncoverable),
-           "lower_bound": bound}
-    if "gap" in metrics:
+           "lower_bound": bound, "missed": len(plan.missed), "failed_regions": len(plan.failed_regions)}
+    if "gap" in metrics:  # the bound is on plans covering every coverable cell: none for a plan that leaves some
         out["reference"] = bound
-        out["gap"] = (cost - bound) / bound if bound > 0 else (0.0 if cost == 0 else None)
+        out["gap"] = None if plan.missed else (cost - bound) / bound if bound > 0 else (0.0 if cost == 0 else None)
     out.update({k: fields[k] for k in ("average_coverage_time", "recovered_pct", "coverage_pct", "coverable_pct",
                                        "path_length", "switches", "turns", "regions", "regions_optimal",
                                        "memo_hits", "nodes", "mopup_commands", "transit_commands", "dag_cost",

@@ -80,6 +80,11 @@ N_STR = (("N_str,1", 3), ("N_str,2", 4))
 LARGE_SCENARIOS = ("tiling_64x64", "indoor_room")
 """Maps beyond the paper's, with {O} and {O, vI, hI} in 4-row stripes and the boustrophedon."""
 STRIPE_METHODS = ("stripes", "stripes-paper")
+ORDER_CHECK = {"label": "stripes {vI,hI} N_str,2 without sweep-order", "method": "stripes", "shapes": "vI,hI",
+               "stripes": 4, "additions": ["fixed-regions", "best-first", "greedy-fallback", "split-sweeps",
+                                           "shortest-joins", "mopup"]}
+"""Ours on {vI, hI}, 4-row stripes, without the ``sweep-order`` addition: what improving the sweeps' order buys
+there (the report reads it beside the row with every addition)."""
 
 PAPER_TABLE2: tuple[dict[str, Any], ...] = (
     {"config": "O", "n_str": "N_str,1", "complete": True, "action_cost": 137, "average_coverage_time": 2.104},
@@ -166,7 +171,7 @@ def cheng2019_study(*, large: bool = True, scenarios_16: Sequence[str] = (TABLE2
     --------
     >>> study = cheng2019_study(large=False)
     >>> len(study.trials()), study.trials()[0].label, study.trials()[0].parameters
-    (34, 'stripes {O} N_str,1', {'shapes': 'O', 'stripes': 3})
+    (35, 'stripes {O} N_str,1', {'shapes': 'O', 'stripes': 3})
     """
     if isinstance(scenarios_16, str) or len(scenarios_16) != 2:
         raise ParameterError(f"scenarios_16 must be Table 2's map and the 16 x 7 map, got {scenarios_16!r}")
@@ -184,6 +189,7 @@ def cheng2019_study(*, large: bool = True, scenarios_16: Sequence[str] = (TABLE2
                 if layers == "O" and "indoor_room" in scenarios:
                     entry["per_scenario"] = {"indoor_room": {"start": "auto"}}
                 entries.append(entry)
+    entries.append({**ORDER_CHECK, "scenarios": [table2]})
     for method in STRIPE_METHODS:
         entries.append({"label": f"{method} {{O,hI}} 2,3,2", "method": method, "shapes": "O,hI",
                         "stripes": list(PAPER_16X7["stripes"]), "scenarios": [small]})
@@ -275,7 +281,7 @@ def _check_run(run) -> StudyRun:
 
 def _is_table2(record: Mapping[str, Any]) -> bool:
     return _name(record["scenario"]) == TABLE2_SCENARIO and record["method"] in STRIPE_METHODS \
-        and _n_str(record) is not None
+        and _n_str(record) is not None and record["label"] != ORDER_CHECK["label"]
 
 
 def _error_kind(error: str | None) -> str | None:
@@ -295,6 +301,8 @@ def _base(record: Mapping[str, Any], part: str) -> dict:
         "average_coverage_time": record.get("average_coverage_time"), "recovered_pct": record.get("recovered_pct"),
         "free": record.get("free"), "coverable": record.get("coverable"), "covered": record.get("covered"),
         "switches": record.get("switches"), "regions": record.get("regions"),
+        "missed": record.get("missed"), "failed_regions": record.get("failed_regions"),
+        "additions": ",".join(record.get("additions") or []),
         "regions_optimal": record.get("regions_optimal"), "mopup_commands": record.get("mopup_commands"),
         "dag_cost": record.get("dag_cost"), "runtime_s": record.get("runtime_s"),
         "error": _error_kind(record.get("error")), "error_message": record.get("error"),
@@ -304,8 +312,10 @@ def _base(record: Mapping[str, Any], part: str) -> dict:
 def report_rows(run: StudyRun) -> list[dict]:
     """One row per trial, the paper's numbers beside ours (the CSV of :func:`write_report`).
 
-    ``part``: ``"table2"`` (Table 2's map, the stripe planners, 3- or 4-row stripes), ``"16x7"``
-    or ``"maps"`` (every other trial); ``n_str``; ours: ``complete``, ``action_cost``,
+    ``part``: ``"table2"`` (Table 2's map, the stripe planners, 3- or 4-row stripes), ``"order"``
+    (:data:`ORDER_CHECK`), ``"16x7"`` or ``"maps"`` (every other trial); ``n_str``; ours: ``complete``,
+    ``missed`` (coverable cells left: the paper's algorithm has no mop-up), ``failed_regions`` (region
+    searches that spent their node budget: the paper's search has none), ``additions``, ``action_cost``,
     ``lower_bound``, ``gap``, ``average_coverage_time``, ``recovered_pct``, cells, ``switches``,
     ``regions``, ``regions_optimal``, ``mopup_commands``, ``dag_cost`` (None: the DAG had no path and
     the mop-up walk covered the map), ``runtime_s``, ``error`` (``"untileable"`` for a tiling-tsp
@@ -321,7 +331,9 @@ def report_rows(run: StudyRun) -> list[dict]:
     rows = []
     for record in run.records:
         paper: dict | None = None
-        if _is_table2(record):
+        if record["label"] == ORDER_CHECK["label"]:
+            row = _base(record, "order")
+        elif _is_table2(record):
             row = _base(record, "table2")
             paper = paper_row(_layers(record), _n_str(record))
         elif _name(record["scenario"]) == PAPER_16X7["scenario"]:
@@ -359,40 +371,44 @@ def _cost(row: Mapping[str, Any]) -> str:
     return row["error"] if row["error"] else _fmt(row["action_cost"])
 
 
-def _table2_md(rows: list[dict]) -> list[str]:
+def _table2_md(rows: list[dict], order_rows: Sequence[dict] = ()) -> list[str]:
     out = ["## Table 2: morphology sets × stripe widths on the 16 × 16 map", "",
-           "Ours by `stripes` (our reading: regions every 4 columns, best-first search, one auxiliary DAG) and by "
-           "`stripes-paper` (the paper's Alg. 5 as written), beside the paper's. Bound: ⌈(coverable − 4) / g⌉; gap: "
-           "the cost over it. Complete: every free cell covered. `(?)`: the paper's row \"Any config with vI, hI\" "
+           "The paper's numbers, then its Alg. 5 as published (`stripes-paper`: cuts at forced poses, a depth-first "
+           "search over simple paths with insertions, cut-edges between stripes, no mop-up, no greedy fallback; a "
+           "region search that spends its node budget fails and is counted under \"cut short\"), then ours "
+           "(`stripes`: every addition of docs/papers/cheng2019.md), then the lower bound ⌈(coverable − 4) / g⌉ on "
+           "any covering plan; gap: the cost over it (none for a plan that leaves cells). Complete: every free cell "
+           "covered; left: coverable cells the plan leaves. `(?)`: the paper's row \"Any config with vI, hI\" "
            "(N_str,1), read as every set holding vI or hI. Average coverage time in command units (see the note "
            "below).", "",
-           "| S | stripes | paper: complete | paper: cost | paper: avg time | complete | cost | bound | gap "
-           "| avg time | re-covered % | regions optimal | runtime s | paper's Alg. 5: complete | cost | avg time |",
-           "|---|---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|"]
+           "| S | stripes | paper: complete | paper: cost | paper: avg time | Alg. 5: complete | left | cut short "
+           "| cost | gap | ours: complete | cost | gap | avg time | re-covered % | regions optimal | runtime s | bound |",
+           "|---|---|---|---:|---:|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|"]
     mine = {(r["layers"], r["n_str"], r["method"]): r for r in rows}
     keys = list(dict.fromkeys((r["layers"], r["n_str"]) for r in rows))
     order = {(layers, n): (i, j) for i, (n, _) in enumerate(N_STR) for j, layers in enumerate(TABLE2_LAYERS)}
     keys.sort(key=lambda k: order.get(k, (9, 9)))
     for layers, n_str in keys:
-        ours, paper_variant = mine.get((layers, n_str, "stripes")), mine.get((layers, n_str, "stripes-paper"))
-        first = ours or paper_variant
+        ours, published = mine.get((layers, n_str, "stripes")), mine.get((layers, n_str, "stripes-paper"))
+        first = ours or published
         paper = [first["paper_complete"], first["paper_action_cost"], first["paper_average_coverage_time"]]
         ambiguous = " (?)" if first["paper_config"] and first["paper_config"].endswith("(?)") else ""
         cells = [_braces(layers), f"{n_str} ({_widths_text(n_str)})",
                  _fmt(paper[0]) + (ambiguous if paper[0] is not None else ""), _fmt(paper[1]), _fmt(paper[2])]
+        if published:
+            cells += [_fmt(published["complete"]), _fmt(published["missed"]), _fmt(published["failed_regions"]),
+                      _cost(published), _pct(published["gap"])]
+        else:
+            cells += ["–"] * 5
         if ours:
-            cells += [_fmt(ours["complete"]), _cost(ours), _fmt(ours["lower_bound"]), _pct(ours["gap"]),
-                      _fmt(ours["average_coverage_time"]), _fmt(ours["recovered_pct"], 1),
-                      f"{_fmt(ours['regions_optimal'])} / {_fmt(ours['regions'])}", _fmt(ours["runtime_s"], 2)]
+            cells += [_fmt(ours["complete"]), _cost(ours), _pct(ours["gap"]), _fmt(ours["average_coverage_time"]),
+                      _fmt(ours["recovered_pct"], 1), f"{_fmt(ours['regions_optimal'])} / {_fmt(ours['regions'])}",
+                      _fmt(ours["runtime_s"], 2)]
         else:
-            cells += ["–"] * 8
-        if paper_variant:
-            cells += [_fmt(paper_variant["complete"]), _cost(paper_variant),
-                      _fmt(paper_variant["average_coverage_time"])]
-        else:
-            cells += ["–"] * 3
+            cells += ["–"] * 7
+        cells.append(_fmt(first["lower_bound"]))
         out.append("| " + " | ".join(cells) + " |")
-    out += [""] + _table2_checks(rows) + [""]
+    out += [""] + _table2_checks(rows, order_rows) + [""]
     return out
 
 
@@ -400,14 +416,33 @@ def _widths_text(n_str: str) -> str:
     return {"N_str,1": "3,3,3,3,4", "N_str,2": "4,4,4,4"}.get(n_str, n_str)
 
 
-def _table2_checks(rows: list[dict]) -> list[str]:
-    out = ["**Against the paper.**", ""]
+def _published_checks(rows: list[dict]) -> list[str]:
+    """What the paper's Alg. 5 as published reaches, beside the paper's completeness."""
+    published = [r for r in rows if r["method"] == "stripes-paper" and r["error"] is None]
+    if not published:
+        return []
+    with_paper = [r for r in published if r["paper_complete"] is not None]
+    agree = [r for r in with_paper if r["complete"] == r["paper_complete"]]
+    covering = [r for r in published if not r["missed"]]
+    cut = [r for r in published if r["failed_regions"]]
+    text = (f"- the paper's Alg. 5 as published (`stripes-paper`) covers every coverable cell on {len(covering)} of "
+            f"{len(published)} rows; its completeness agrees with the paper's on {len(agree)} of {len(with_paper)} "
+            f"rows with a paper value. Some region search spent its node budget on {len(cut)} rows")
+    if cut:
+        text += (f" ({sum(r['failed_regions'] for r in cut)} searches): its depth-first search over simple paths in "
+                 "regions as wide as a stripe grows exponentially, the paper gives no bound on it, and a region "
+                 "whose search is cut short has no walk, so the DAG routes around it or has no path")
+    return [text + "."]
+
+
+def _table2_checks(rows: list[dict], order_rows: Sequence[dict] = ()) -> list[str]:
+    out = ["**Against the paper.**", ""] + _published_checks(rows)
     ours = [r for r in rows if r["method"] == "stripes" and r["error"] is None]
     with_paper = [r for r in ours if r["paper_complete"] is not None]
     agree = [r for r in with_paper if r["complete"] == r["paper_complete"]]
     disagree = [f"{_braces(r['layers'])} {r['n_str']}" for r in with_paper if r["complete"] != r["paper_complete"]]
     if with_paper:
-        out.append(f"- completeness agrees with the paper on {len(agree)} of {len(with_paper)} rows"
+        out.append(f"- ours (`stripes`): completeness agrees with the paper on {len(agree)} of {len(with_paper)} rows"
                    + (f"; not on {', '.join(disagree)}" if disagree else "") + ". Our plans cover every coverable cell "
                    "whatever the stripe width (a stripe borrows rows where its own are too narrow, and a mop-up walk "
                    "visits what the stripes leave), so completeness depends on the morphology set alone; the paper's "
@@ -420,7 +455,7 @@ def _table2_checks(rows: list[dict]) -> list[str]:
                    f"(the paper: 112 / 120 = 0.93; the issue's target ≤ 0.85: {'met' if ratio <= 0.85 else 'not met'}).")
     pair = by.get(("vI,hI", "N_str,2"))
     if pair and pair["action_cost"]:
-        out.append(_vi_hi_text(pair))
+        out.append(_vi_hi_text(pair, next((r for r in order_rows if r["error"] is None), None)))
     n1, n2 = by.get(("O", "N_str,1")), o
     if n1 and n2:
         out.append(f"- {{O}}: N_str,1 {n1['action_cost']} against N_str,2 {n2['action_cost']} (the paper: 137 > 120; a "
@@ -440,8 +475,9 @@ def _table2_checks(rows: list[dict]) -> list[str]:
     return out
 
 
-def _vi_hi_text(row: dict) -> str:
-    """Why {vI, hI} costs more here than in the paper: its switch fits at few cells of the map."""
+def _vi_hi_text(row: dict, unordered: Mapping[str, Any] | None = None) -> str:
+    """Why {vI, hI} costs more here than in the paper: its switch fits at few cells of the map; with
+    ``unordered`` (the run's :data:`ORDER_CHECK` row) what the sweeps' order improvement bought."""
     text = (f"- {{vI, hI}}, N_str,2: {row['action_cost']} against the paper's 119. Not a search deficiency but the "
             "model's switch: vI ↔ hI is one `2r`, the whole robot turning about B2, whose sweep (16 cells around "
             "B2) must be free")
@@ -454,11 +490,13 @@ def _vi_hi_text(row: dict) -> str:
         text += f" (on this map at {cells} of its {int((~lg.workspace.occupancy).sum())} free cells)"
     except HtetroError:
         pass
-    return text + (", never in the bottom or top 4-row stripe (the turn leaves the map). So most stripes split "
-                   "into a vI piece and an hI piece, swept apart and joined by transit legs; the paper's Fig. 9 "
-                   "lets a switch clear a small neighbourhood, which ours cannot. Improving the order of those "
-                   "sweeps on the whole plan took it from 190 to 173; `--ends both` (both directions, folded "
-                   "sweeps) finds no cheaper plan (benchmarks/README.md).")
+    text += (", never in the bottom or top 4-row stripe (the turn leaves the map). So most stripes split into a vI "
+             "piece and an hI piece, swept apart and joined by transit legs; the paper's Fig. 9 lets a switch clear a "
+             "small neighbourhood, which ours cannot.")
+    if unordered is not None and unordered.get("action_cost") is not None:
+        text += (f" Improving the order of those sweeps on the whole plan (the `sweep-order` addition) took it from "
+                 f"{unordered['action_cost']} (this run, without it) to {row['action_cost']}.")
+    return text
 
 
 def _maps_md(rows: list[dict], title: str, intro: str) -> list[str]:
@@ -528,7 +566,7 @@ def report(run: StudyRun, *, figures: Mapping[str, str] | None = None) -> str:
            "the simulator. The paper reports no runtimes and no optimum; our lower bound and gap stand beside.", ""]
     table2 = [r for r in rows if r["part"] == "table2"]
     if table2:
-        out += _table2_md(table2)
+        out += _table2_md(table2, [r for r in rows if r["part"] == "order"])
     small = [r for r in rows if r["part"] == "16x7"]
     if small:
         out += _maps_md(small, "## The 16 × 7 map (Figs. 8b, 10, 11)",
@@ -560,7 +598,8 @@ def report(run: StudyRun, *, figures: Mapping[str, str] | None = None) -> str:
                         "the pieces joined by transit legs (shortest paths in the workspace graph) and taken in the "
                         "order the robot meets them, so a room is covered whole before the robot crosses the doorway. "
                         "\"no DAG path\" would mark a plan covered by the mop-up walk alone.")
-    out += _method_checks([r for r in rows if r["part"] != "table2"] + [r for r in table2 if r["n_str"] == "N_str,2"])
+    out += _method_checks([r for r in rows if r["part"] not in ("table2", "order")]
+                          + [r for r in table2 if r["n_str"] == "N_str,2"])
     if figures:
         out += ["## Figures", ""] + [f"- {name}: [{path}]({path})" for name, path in figures.items()] + [""]
     failed = [r for r in rows if r["error"] and r["error"] != "untileable"]

@@ -17,5 +17,5 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "CoveragePlan": "._result", "UNCOVERABLE_REASONS": "._result", "RECOVERED_TIME": "._result",
     "parse_layers": "._layers", "Layer": "._layers", "LayerGraph": "._layers",
     "workspace_graph": "._layers", "stripe_graph": "._layers",
-    "stripe_widths": "._stripes", "ENDS": "._spec", "MOPUP_ORDERS": "._spec",
+    "stripe_widths": "._stripes", "ENDS": "._spec", "MOPUP_ORDERS": "._spec", "STRIPES_ADDITIONS": "._spec",
 })

@@ -60,9 +60,12 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
           columns, every region searched for its cheapest covering walk, and one auxiliary DAG
           (networkx) picking the ports and layers between them (see
           ``htetro_opt.solvers.coverage._stripes`` for our reading of the paper);
-        - ``"stripes-paper"``: the paper's Alg. 5 as written: regions cut only at forced poses (the
-          only pose of the stripe covering some cell), a depth-first search over simple paths (no
-          vertex twice, §IV-D), and on failure a pose covering an uncovered cell inserted as a cut;
+        - ``"stripes-paper"``: the paper's Alg. 5 as written, none of our additions: regions cut only
+          at forced poses (the only pose of the stripe covering some cell), a depth-first search over
+          simple paths (no vertex twice, §IV-D), on failure a pose covering an uncovered cell inserted
+          as a cut, stripes joined by cut-edges, no mop-up. The paper's search has no node budget: a
+          region search that spends ``budget`` fails (listed in ``failed_regions``), and cells the
+          stripes leave are left uncovered (``missed``); either makes ``success`` false;
         - ``"boustrophedon"``: lanes as tall as the first layer's footprint, swept alternately;
         - ``"tiling-tsp"``: tile the free cells with the layers' shapes (any heading), order the
           tiles as a TSP and drive through their poses by minimum-command legs.
@@ -82,15 +85,21 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
     region_columns : int, keyword-only
         Columns of a region (default 4).
     budget : int, keyword-only
-        Search nodes per region search before it falls back to its greedy walk (default 20 000).
+        Search nodes per region search (default 20 000); past them the region takes its greedy walk
+        (``greedy-fallback``) or fails and is listed in ``failed_regions``.
+    additions : collection of str, keyword-only
+        Stripe methods: our additions switched on, names of
+        :data:`~htetro_opt.solvers.coverage.STRIPES_ADDITIONS` (``"all"``, ``"none"`` or ``"a,b"`` too):
+        all for ``"stripes"``, none for ``"stripes-paper"``; the plan's ``additions`` lists them.
     clearance : float, keyword-only
         δ in cells (MODEL.md §4).
     time_limit : float, optional, keyword-only
-        Seconds; past them the remaining regions take their greedy walk (``time_limited``). None: no limit.
+        Seconds; past them the remaining regions take their greedy walk, or fail without
+        ``greedy-fallback`` (``time_limited``). None: no limit.
     memo : bool, keyword-only
         Memoise region searches by their content (True); False gives the same plan, slower.
     ends : {"sweep", "both"}, keyword-only
-        Stripe methods: where a stripe's sweep may be left. ``"sweep"`` (default, the paper's
+        ``"stripes"`` only: where a stripe's sweep may be left. ``"sweep"`` (default, the paper's
         cut-edges): at its far end, each sweep in the direction the stripes' order gives it.
         ``"both"``: the start end too; every sweep is in the DAG in both directions, and (default
         variant) also folded, out for the lower half of its rows and back for the upper half, so
@@ -98,15 +107,16 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
         is a superset of ``"sweep"``'s, and the plan keeps the cheaper of the two plans with their
         mop-ups: it never costs more. About four times the work.
     mopup : {"sequenced", "nearest"}, keyword-only
-        How the cells the sweeps or lanes left are visited: nearest first (the issue's reading of the
-        paper), or ``"sequenced"`` (default): those same vertices re-ordered by 2-opt and Or-opt over
-        the exact leg costs, kept only when cheaper.
+        How the cells the sweeps or lanes left are visited (stripe methods: with the ``mopup``
+        addition): nearest first, or ``"sequenced"`` (default): those same vertices re-ordered by
+        2-opt and Or-opt over the exact leg costs, kept only when cheaper.
 
     Returns
     -------
     CoveragePlan
         Re-validated in the simulator. Cells no pose of S covers, or that the start cannot reach, are
-        reported in ``uncoverable``, not searched for; a plan is ``complete`` when every free cell is covered.
+        reported in ``uncoverable``, not searched for; a plan is ``complete`` when every free cell is covered,
+        ``success`` when every coverable cell is and no region search failed (``missed``, ``failed_regions``).
 
     Raises
     ------
@@ -178,21 +188,26 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
                                stripes=(), info=info)
     if method in ("stripes", "stripes-paper"):
         deadline = None if time_limit is None else began + time_limit
+        on = options["additions"]
+        ends = options.get("ends", "sweep")  # stripes-paper's sweeps leave at their far end (the paper's cut-edges)
         outcome = plan_stripes(lg, cov, start_node, goal_node, widths, region_columns=options["region_columns"],
-                               budget=options["budget"], deadline=deadline, memo=options["memo"],
-                               paper=method == "stripes-paper", ends=options["ends"], mopup=options["mopup"])
+                               budget=options["budget"], deadline=deadline, memo=options["memo"], additions=on,
+                               ends=ends, mopup=options["mopup"])
         path = outcome.path
         extras = {"stripes_detail": tuple(outcome.stripes), "regions": outcome.regions,
                   "regions_optimal": outcome.regions_optimal, "memo_hits": outcome.memo_hits,
                   "nodes": outcome.nodes, "dag_cost": outcome.dag_cost, "time_limited": outcome.time_limited,
-                  "info": outcome.info, "ends": options["ends"]}
+                  "info": {**outcome.info, "additions": list(on)}, "ends": ends,
+                  "failed_regions": tuple(outcome.failed.values())}
         used_stripes = widths
+        mopup = "mopup" in on  # without it, what the stripes leave stays uncovered and the plan says so
     else:
         path = boustrophedon_path(lg, start_node, cov.reachable)
         extras = {"info": {}}
         used_stripes = ()
+        mopup = True
     lanes = len(path) - 1
-    added = mop_up(lg, path, cov.coverable, cov.reachable, order=options["mopup"], goal=goal_node)
+    added = mop_up(lg, path, cov.coverable, cov.reachable, order=options["mopup"], goal=goal_node) if mopup else []
     mopup_path = [path[-1]] + added
     tail = []
     if goal_node is not None and mopup_path[-1] != goal_node:

@@ -11,15 +11,22 @@ search ordered best-first (A*), with the same kind of bound: a state costs at le
 ``max(distance to the exit, ⌈uncovered / g⌉, max over uncovered targets t of the cheapest way to
 cover t and then reach the exit)``, g being the most new cells one command adds. The bound is
 consistent, so the first state popped at the exit with every target covered is optimal: a search
-that ends within its node budget is a proof. When the budget runs out, the region falls back to the
-greedy walk (nearest vertex covering an uncovered target, then the exit) and is reported as not
-proven optimal.
+that ends within its node budget is a proof (the ``best-first`` addition).
 
 The paper variant (:func:`search_simple`, :func:`search_inserting`) is Alg. 5 as written: a
 depth-first branch and bound over *simple* paths (no vertex twice: §IV-D's "each vertex is visited
 once", a check Algs. 5–6 lack), moves ordered by new cells, then progress along the sweep; when no
 simple path covers the targets, a pose covering the first uncovered target is inserted (Alg. 5
-l. 12–13) and the two halves are searched apart, each simple.
+l. 12–13) and the two halves are searched apart, each simple. The paper gives no bound on the
+insertions; ours, :data:`MAX_INSERTIONS`, only turns an insertion that repeats itself forever into a
+region without a walk.
+
+**The node budget.** The paper's search has none: it runs to its end. Ours stops a search after
+``budget`` expansions. With ``fallback`` (the ``greedy-fallback`` addition) the region then takes the
+search's best walk so far, or the greedy walk (nearest vertex covering an uncovered target, then the
+exit), reported as not proven optimal; without it the search returns an *exhausted* result
+(:attr:`RegionResult.exhausted`): the region has no walk and the plan reports it as failed, since
+the paper's algorithm was not run to its end there.
 """
 
 from __future__ import annotations
@@ -34,7 +41,8 @@ __all__ = ["Region", "RegionResult", "search_region", "greedy_walk", "search_sim
            "MAX_INSERTIONS"]
 
 MAX_INSERTIONS = 8
-"""Poses the paper variant inserts into one region (Alg. 5 l. 12–13) before it takes the greedy walk."""
+"""Poses the paper variant inserts into one region (Alg. 5 l. 12–13), nested, before the region has no walk
+(then the greedy walk with ``fallback``)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -60,6 +68,8 @@ class RegionResult:
     path: tuple[int, ...]  # local vertices, entry first
     optimal: bool
     nodes: int
+    exhausted: bool = False  # the node budget ran out: no walk (path empty) unless the search had one so far
+    missing: int = 0  # targets (bits) the walk leaves uncovered: the paper's search keeps its maximum coverage
 
 
 def _segment(region: Region, a: int, b: int) -> list[int]:
@@ -99,10 +109,12 @@ def greedy_walk(region: Region, entry: int, exit: int | None) -> RegionResult | 
     return RegionResult(int(round(cost)), tuple(path), False, 0)
 
 
-def search_region(region: Region, entry: int, exit: int | None, *, gain: int, budget: int) -> RegionResult | None:
+def search_region(region: Region, entry: int, exit: int | None, *, gain: int, budget: int,
+                  fallback: bool = True) -> RegionResult | None:
     """The cheapest walk from ``entry`` covering every target and ending at ``exit`` (anywhere for
     None), by A* over (vertex, covered) with at most ``budget`` expansions; past the budget, the
-    greedy walk. None when the exit cannot be reached or a target cannot be covered."""
+    greedy walk (``fallback``) or an exhausted result without a walk. None when the exit cannot be
+    reached or a target cannot be covered."""
     dist, bits, full = region.dist, region.bits, region.full
     n = len(bits)
     if exit is not None and not math.isfinite(dist[entry, exit]):
@@ -136,7 +148,7 @@ def search_region(region: Region, entry: int, exit: int | None, *, gain: int, bu
     best_g = {start: 0}
     parent: dict = {start: None}
     heap = [(bound(entry, full & ~bits[entry]), 0, entry, bits[entry])]
-    expanded = 0
+    expanded, cut_short = 0, False
     adjacency = region.adjacency
     while heap:
         f, neg_g, v, mask = heapq.heappop(heap)
@@ -151,6 +163,7 @@ def search_region(region: Region, entry: int, exit: int | None, *, gain: int, bu
             return RegionResult(int(g), tuple(path[::-1]), True, expanded)
         expanded += 1
         if expanded > budget:
+            cut_short = True
             break
         for w, c in adjacency[v]:
             m2 = mask | bits[w]
@@ -163,10 +176,14 @@ def search_region(region: Region, entry: int, exit: int | None, *, gain: int, bu
                 best_g[key] = g2
                 parent[key] = (v, mask)
                 heapq.heappush(heap, (g2 + h, -g2, w, m2))
-    fallback = greedy_walk(region, entry, exit)
-    if fallback is None:
+    if not cut_short:  # searched to the end: no covering walk
         return None
-    return RegionResult(fallback.cost, fallback.path, False, expanded)
+    if not fallback:
+        return RegionResult(0, (), False, expanded, exhausted=True)
+    walk = greedy_walk(region, entry, exit)
+    if walk is None:
+        return None
+    return RegionResult(walk.cost, walk.path, False, expanded)
 
 
 class _Budget(Exception):
@@ -177,22 +194,38 @@ def search_simple(region: Region, entry: int, exit: int | None, *, gain: int, bu
                   targets: int | None = None) -> RegionResult | None:
     """The cheapest *simple* walk (no vertex twice) from ``entry`` covering ``targets`` (all by
     default) and ending at ``exit`` (anywhere for None): a depth-first branch and bound with at most
-    ``budget`` expansions. Past the budget, the best walk found so far (not proven optimal); None
-    when there is none."""
+    ``budget`` expansions. Past the budget, an exhausted result holding the best walk found so far
+    (its path empty if none); None when there is no simple walk."""
+    return _simple(region, entry, exit, gain=gain, budget=budget, targets=targets)[0]
+
+
+def _simple(region: Region, entry: int, exit: int | None, *, gain: int, budget: int,
+            targets: int | None = None) -> tuple[RegionResult | None, int]:
+    """The cheapest *simple* walk (no vertex twice) from ``entry`` covering ``targets`` (all by
+    default): :func:`search_simple`'s result, and the expansions it took (also when there is no walk).
+
+    As the paper's RBT, the search keeps the walk of *maximum coverage* (then least cost) ending at the
+    exit: when no simple walk covers every target, that walk is returned with the targets it leaves
+    (:attr:`RegionResult.missing`), for :func:`search_inserting` to insert an intermediate pose."""
     full = region.full if targets is None else targets
     bits = [b & full for b in region.bits]
     dist = region.dist
     n = len(bits)
     if exit is not None and not math.isfinite(dist[entry, exit]):
-        return None
+        return None, 0
     dexit = dist[:, exit].tolist() if exit is not None else [0.0] * n
     progress = region.progress or (0,) * n
     best_cost, best_path = math.inf, None
+    part = [(-1, 0), None, 0]  # (covered targets, −cost), walk, mask: the maximum coverage so far
     path, on_path, expanded = [entry], {entry}, 0
     adjacency = region.adjacency
 
     def dfs(v: int, mask: int, cost: int) -> None:
         nonlocal best_cost, best_path, expanded
+        if exit is None or v == exit:
+            key = ((mask & full).bit_count(), -cost)
+            if key > part[0]:
+                part[:] = [key, tuple(path), mask]
         if mask == full and (exit is None or v == exit):
             if cost < best_cost:
                 best_cost, best_path = cost, tuple(path)
@@ -212,53 +245,81 @@ def search_simple(region: Region, entry: int, exit: int | None, *, gain: int, bu
             on_path.discard(w)
             path.pop()
 
-    optimal = True
     try:
         dfs(entry, bits[entry], 0)
     except _Budget:
-        optimal = False
+        return RegionResult(0 if best_path is None else int(best_cost), best_path or (), False, expanded,
+                            exhausted=True), expanded
     if best_path is None:
-        return None
-    return RegionResult(int(best_cost), best_path, optimal, expanded)
+        if part[1] is None:
+            return None, expanded
+        return RegionResult(-part[0][1], part[1], False, expanded, missing=full & ~part[2]), expanded
+    return RegionResult(int(best_cost), best_path, True, expanded), expanded
 
 
-def search_inserting(region: Region, entry: int, exit: int | None, *, gain: int, budget: int) -> RegionResult | None:
-    """Alg. 5 with its failure rule: a simple walk (:func:`search_simple`); failing that, insert the
-    pose nearest the entry that covers the uncovered target earliest along the sweep, and search the
-    halves (targets up to that pose, then the rest) apart, up to :data:`MAX_INSERTIONS` poses; failing
-    that, or past ``budget`` expansions in all, the greedy walk. None when a target or the exit cannot
-    be reached at all."""
+def search_inserting(region: Region, entry: int, exit: int | None, *, gain: int, budget: int,
+                     fallback: bool = True) -> RegionResult | None:
+    """Alg. 5 with its failure rule (§IV-D, Fig. 10): a simple walk of maximum coverage
+    (:func:`search_simple`); when it leaves targets, insert the pose nearest the entry that covers
+    the one it leaves earliest along the sweep, search the halves (targets up to that pose, then the
+    rest) apart in the same way, and keep the better (more targets covered, then fewer commands), up
+    to :data:`MAX_INSERTIONS` nested poses. Targets no insertion covers are left (the paper: "the grids
+    will be left unvisited while the algorithm moves on"): :attr:`RegionResult.missing`.
+
+    Past ``budget`` expansions in all, with ``fallback`` (the ``greedy-fallback`` addition) a search
+    keeps its best simple walk so far, and a region left without a walk takes the greedy walk; without
+    it the result is exhausted (no walk: the paper's search has no budget, it would have gone on).
+    None when a target or the exit cannot be reached at all, or (without ``fallback``) when the
+    insertions find no walk."""
     if exit is not None and not math.isfinite(region.dist[entry, exit]):
         return None
     order = region.target_progress or (0,) * region.full.bit_length()
     spent = [0]
+    cut_short = [False]
 
     def solve(a: int, b: int | None, targets: int, depth: int):
         left = budget - spent[0]  # one budget for the region, insertions included
         if left <= 0:
+            cut_short[0] = True
             return None
-        result = search_simple(region, a, b, gain=gain, budget=left, targets=targets)
-        spent[0] += left if result is None else result.nodes
-        if result is not None or depth >= MAX_INSERTIONS:
+        result, expanded = _simple(region, a, b, gain=gain, budget=left, targets=targets)
+        spent[0] += expanded
+        if result is not None and result.exhausted:
+            cut_short[0] = True
+            return result if fallback and result.path else None
+        if result is None or not result.missing or depth >= MAX_INSERTIONS:
             return result
-        unc = targets & ~region.bits[a]
-        if not unc:
-            return None
+        unc = result.missing
         first = min((t for t in range(unc.bit_length()) if unc >> t & 1), key=lambda t: (order[t], t))
         covers = [v for v, bv in enumerate(region.bits) if bv >> first & 1 and math.isfinite(region.dist[a, v])]
         if not covers:
-            return None
+            return result
         p = min(covers, key=lambda v: (region.dist[a, v], v))
-        before = sum(1 << t for t in range(unc.bit_length()) if unc >> t & 1 and order[t] <= order[first])
+        before = sum(1 << t for t in range(targets.bit_length()) if targets >> t & 1 and order[t] <= order[first])
+        if p == b and before == targets:  # the same region again: no insertion helps
+            return result
         head = solve(a, p, before, depth + 1)
-        tail = solve(p, b, targets & ~before, depth + 1)
+        tail = solve(p, b, targets & ~before, depth + 1) if head is not None else None
         if head is None or tail is None:
-            return None
-        return RegionResult(head.cost + tail.cost, head.path + tail.path[1:], False, 0)
+            return None if cut_short[0] and not fallback else result
+        covered = 0
+        for v in head.path + tail.path:
+            covered |= region.bits[v]
+        joined = RegionResult(head.cost + tail.cost, head.path + tail.path[1:], False, 0,
+                              missing=targets & ~covered)
+        better = (joined.missing.bit_count(), joined.cost) < (result.missing.bit_count(), result.cost)
+        return joined if better else result
 
     found = solve(entry, exit, region.full, 0)
+    if found is not None and cut_short[0] and not fallback:  # some half was cut short: not the paper's answer
+        found = None
+    if found is not None and found.missing and fallback:  # ours: a walk covering all, not one leaving targets
+        found = greedy_walk(region, entry, exit) or found
     if found is None:
+        if not fallback:
+            return RegionResult(0, (), False, spent[0], exhausted=True) if cut_short[0] else None
         found = greedy_walk(region, entry, exit)
         if found is None:
             return None
-    return RegionResult(found.cost, found.path, found.optimal, spent[0])
+    optimal = found.optimal and not cut_short[0]
+    return RegionResult(found.cost, found.path, optimal, spent[0], missing=found.missing)

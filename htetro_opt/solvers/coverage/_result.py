@@ -82,7 +82,14 @@ class CoveragePlan(Result):
         Commands of the legs outside the DAG: start/goal transits, and the mop-up of what the
         stripes left uncovered.
     time_limited : bool
-        The time limit cut the search short (the plan is still complete and valid).
+        The time limit cut the search short (the plan is still valid; without ``greedy-fallback`` the
+        regions searched past it fail).
+    failed_regions : tuple of dict
+        Stripe methods without the ``greedy-fallback`` addition: every region search that spent its
+        node budget (or ran past the time limit) and so has no walk, each with its ``stripe``, ``rows``,
+        ``columns`` ([c0, c1)), ``direction``, ``entry`` and ``exit`` poses (``exit`` None: a free
+        end), ``reason`` (``"node budget"`` or ``"time limit"``) and ``nodes``. Any makes ``success``
+        false: the paper's algorithm was not run to its end there.
     ends : str or None
         The stripe methods' ``ends`` option (``"sweep"`` or ``"both"``); None for the other methods.
     runtime_s : float
@@ -120,6 +127,7 @@ class CoveragePlan(Result):
     switches: int = 0
     time_limited: bool = False
     ends: str | None = None
+    failed_regions: tuple = ()
     runtime_s: float = 0.0
     info: Mapping = field(default_factory=dict)
 
@@ -184,14 +192,25 @@ class CoveragePlan(Result):
         return sum(a != b for a, b in zip(moves[:-1], moves[1:]))
 
     @property
+    def missed(self) -> tuple[tuple[int, int], ...]:
+        """The coverable cells the plan leaves uncovered, (x, y) bottom row first (none with a mop-up)."""
+        ys, xs = np.nonzero(self.coverable & ~self.covered)
+        return tuple((int(x), int(y)) for y, x in zip(ys, xs))
+
+    @property
     def success(self) -> bool:
-        return bool((self.covered | ~self.coverable).all())
+        """Every coverable cell covered, and no region search failed (:attr:`failed_regions`)."""
+        return bool((self.covered | ~self.coverable).all()) and not self.failed_regions
 
     @property
     def message(self) -> str:
-        missed = int((self.coverable & ~self.covered).sum())
+        missed = len(self.missed)
+        failed = len(self.failed_regions)
+        searches = f"; {failed} region searches spent their budget without a walk" if failed else ""
         if missed:
-            return f"{missed} coverable cells left uncovered ({self.action_cost} commands)"
+            return f"{missed} coverable cells left uncovered ({self.action_cost} commands){searches}"
+        if failed:
+            return f"covered every coverable cell in {self.action_cost} commands{searches}"
         unreachable = f"; {len(self.uncoverable)} free cells no pose of the set covers" if self.uncoverable else ""
         return f"covered every coverable cell in {self.action_cost} commands{unreachable}"
 
@@ -226,6 +245,8 @@ class CoveragePlan(Result):
             "mopup_commands": self.mopup_commands,
             "stripes_detail": [dict(d) for d in self.stripes_detail],
             "ends": self.ends,
+            "missed": [{"x": x, "y": y} for x, y in self.missed],
+            "failed_regions": [dict(r) for r in self.failed_regions],
         }
 
 

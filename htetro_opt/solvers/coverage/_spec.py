@@ -7,11 +7,38 @@ task read (see :mod:`htetro_opt._spec`). Importing it loads no networkx or scipy
 
 from __future__ import annotations
 
-from htetro_opt._spec import Method, Option, Problem, TaskSpec, at_most, bytes_text, choice, integer, real
+from htetro_opt._spec import (Method, Option, Problem, TaskSpec, additions, at_most, bytes_text, choice, integer,
+                              real)
 from htetro_opt._validation import check_bool, check_int, check_time_limit
 from htetro_opt.errors import ParameterError, ScenarioError
 
-__all__ = ["SPEC", "DEFAULT_LAYERS", "ENDS", "MOPUP_ORDERS", "STARTS"]
+__all__ = ["SPEC", "DEFAULT_LAYERS", "ENDS", "MOPUP_ORDERS", "STARTS", "STRIPES_ADDITIONS"]
+
+STRIPES_ADDITIONS = {
+    "fixed-regions": "a sweep is cut into regions every region_columns columns, on two grids offset by half a region "
+                     "(the DAG takes the cheaper), each region searched in a window of 3 columns beyond its own; the "
+                     "paper cuts a stripe only at its forced poses and searches each region in the whole stripe",
+    "best-first": "a region is searched best-first (A*) over (vertex, covered cells), vertices revisited, with a "
+                  "consistent bound that proves the optimum; the paper's Alg. 5 is a depth-first search over simple "
+                  "paths that inserts a pose as a cut when no simple path covers the region",
+    "greedy-fallback": "a region search that spends its node budget (or runs past the time limit) takes its best "
+                       "walk so far, or the greedy walk; the paper's search has no budget, so without it the region "
+                       "fails and the result lists it",
+    "split-sweeps": "a stripe a wall splits into pieces is also planned piece by piece, the pieces joined by transit "
+                    "legs, and the cheaper plan kept; the paper widens it until one piece covers it (Alg. 5 l. 14)",
+    "sweep-order": "the order and directions of the sweeps are improved by moving or reversing one at a time while "
+                   "the whole plan's cost drops; the paper sweeps the stripes as a boustrophedon",
+    "shortest-joins": "consecutive stripes are joined by shortest paths in the workspace graph; the paper joins them "
+                      "by its cut-edges, translations in one layer through both bands (Def. 9)",
+    "mopup": "the cells the stripes leave uncovered are visited afterwards by a walk (in the mopup option's order); "
+             "the paper has no such walk, so without it they are left uncovered and listed",
+}
+"""Our additions to Cheng et al. 2019's Alg. 5, by name: ``stripes`` runs them all, ``stripes-paper`` none; each
+is switched on or off singly by the ``additions`` option (docs/papers/cheng2019.md). ``ends="both"`` (both
+directions and folded sweeps) is a further option of ours, of ``stripes`` only and off by default (about four
+times the work); ``memo`` is none: it gives the same plan."""
+
+_PARAMETERS = {"region_columns": "fixed-regions", "mopup": "mopup"}  # option -> the addition it sets
 
 DEFAULT_LAYERS = ("O", "vI", "hI")
 """The paper's best morphology set (Table 2: {O, vI, hI} with 4-row stripes)."""
@@ -80,26 +107,33 @@ OPTIONS = (
     Option("region_columns", integer(1), "columns of a region", default=4, type=int,
            metavar="N"),
     Option("budget", at_most(integer(1), 10_000_000, lambda v: f"search nodes a region may hold in memory, about "
-                             f"{bytes_text(v * 200)}"), "search nodes per region before its greedy walk is "
-           "taken", default=20_000, type=int, metavar="N"),
+                             f"{bytes_text(v * 200)}"), "search nodes per region search; past them the region takes "
+           "its greedy walk (greedy-fallback) or fails (reported)", default=20_000, type=int, metavar="N"),
     Option("ends", choice(ENDS), "leave a stripe at its sweep's far end (sweep) or at either end (both: every "
            "stripe swept either way, or out and back; never costlier)", default="sweep", choices=ENDS),
-    Option("mopup", choice(MOPUP_ORDERS), "how the cells the sweeps left are visited: re-ordered by 2-opt and "
-           "Or-opt over exact leg costs (sequenced), or nearest first", default="sequenced", choices=MOPUP_ORDERS),
+    Option("mopup", choice(MOPUP_ORDERS), "how the cells the sweeps left are visited (the mopup addition): re-ordered "
+           "by 2-opt and Or-opt over exact leg costs (sequenced), or nearest first", default="sequenced",
+           choices=MOPUP_ORDERS),
+    Option("additions", additions(STRIPES_ADDITIONS), "the stripes' additions of ours switched on: all, none, or "
+           f"some of {', '.join(STRIPES_ADDITIONS)} (docs/papers/cheng2019.md)", metavar="NAMES"),
     Option("memo", check_bool, "memoise region searches by their content (False gives the same plan, slower)",
            default=True, flag="", study=False),
-    Option("time_limit", check_time_limit, "seconds; past them the remaining regions take their greedy walk",
-           type=float, metavar="S", default_text="none"),
+    Option("time_limit", check_time_limit, "seconds; past them the remaining regions take their greedy walk "
+           "(greedy-fallback) or fail (reported)", type=float, metavar="S", default_text="none"),
 )
 
 _PAPER = "Cheng et al. 2019"
-_STRIPES = ("stripes", "region_columns", "budget", "ends", "mopup", "memo", "time_limit")
+_STRIPES = ("stripes", "region_columns", "budget", "mopup", "memo", "time_limit", "additions")
 
 METHODS = (
     Method("stripes", "._stripes:plan_stripes", "the paper's stripes, regions and auxiliary DAG, with our "
-           "readings and additions", _STRIPES, origin="ours", paper=_PAPER, family=("stripes",)),
-    Method("stripes-paper", "._stripes:plan_stripes", "its Alg. 5 (simple paths, cuts at forced poses)", _STRIPES,
-           presets={"paper": True}, origin="paper", paper=_PAPER, family=("stripes",)),
+           "readings and additions", (*_STRIPES, "ends"), defaults={"additions": tuple(STRIPES_ADDITIONS)},
+           origin="ours", paper=_PAPER, family=("stripes",), revision=2),
+    # Alg. 5 as published: cuts at forced poses, a depth-first search over simple paths with insertions, cut-edges
+    # between stripes, no mop-up; a region search past its node budget fails (the paper's search has none)
+    Method("stripes-paper", "._stripes:plan_stripes", "its Alg. 5 as published (simple paths, cuts at forced poses, "
+           "no mop-up)", _STRIPES, defaults={"additions": ()}, origin="paper", paper=_PAPER, family=("stripes",),
+           revision=2),
     Method("boustrophedon", "._baselines:boustrophedon_path", "lanes in the first layer (a baseline)",
            ("mopup",), origin="baseline", paper=_PAPER),
     Method("tiling-tsp", "._baselines:tiling_tsp_tokens", "tile with the shapes, order the tiles, drive through "
@@ -121,10 +155,21 @@ def _pose(scenario, *, label, shapes, start) -> Problem:
     return Problem(loaded.name, (loaded.workspace, shapes), kwargs=ends, scenario=loaded)
 
 
+def _relations(method: Method, given: dict, label) -> None:
+    """An option given for an addition that is off is refused (it would change nothing)."""
+    if not method.takes("additions"):
+        return
+    on = given.get("additions", method.defaults.get("additions", ()))
+    for option, addition in _PARAMETERS.items():
+        if option in given and addition not in on:
+            raise ParameterError(f"{label(option)} sets the {addition} addition, which is off in {method.name}: "
+                                 f"switch it on with {label('additions')} (e.g. {addition})")
+
+
 SPEC = TaskSpec(
     "coverage", package="htetro_opt.solvers.coverage", entry="._dispatch:plan_coverage", options=OPTIONS,
     methods=METHODS, default="stripes", families={"stripes": "the stripes methods"},
-    common=("shapes", "start", "clearance"), pose=_pose,
+    common=("shapes", "start", "clearance"), relations=_relations, pose=_pose,
 )
 """The coverage task (see the module docstring). It has no exact method: a study measures a plan
 against its lower bound on the action cost instead."""

@@ -60,8 +60,9 @@ from scipy.sparse.csgraph import connected_components, dijkstra
 from htetro_opt._validation import check_int
 from htetro_opt.errors import ParameterError
 from htetro_opt.solvers.coverage._layers import LayerGraph
-from htetro_opt.solvers.coverage._rbt import Region, greedy_walk, search_inserting, search_region
+from htetro_opt.solvers.coverage._rbt import Region, RegionResult, greedy_walk, search_inserting, search_region
 from htetro_opt.solvers.coverage._result import Coverability
+from htetro_opt.solvers.coverage._spec import STRIPES_ADDITIONS
 
 __all__ = ["stripe_widths", "plan_stripes", "StripeOutcome", "shortest_path", "mop_up", "WINDOW_MARGIN", "CUT_OFFSETS"]
 
@@ -154,6 +155,7 @@ class StripeOutcome:
     nodes: int = 0
     time_limited: bool = False
     info: dict = field(default_factory=dict)
+    failed: dict = field(default_factory=dict)  # region key -> the failed search (JSON-ready), greedy-fallback off
 
 
 def shortest_path(lg: LayerGraph, source: int, target: int, matrix=None) -> tuple[float, list[int]]:
@@ -239,11 +241,17 @@ def mop_up(lg: LayerGraph, path: list[int], coverable: np.ndarray, reachable: np
 
 class _Planner:
     def __init__(self, lg: LayerGraph, cov: Coverability, start: int, goal: int | None, widths, *,
-                 region_columns: int, budget: int, deadline: float | None, memo: bool, paper: bool = False,
-                 widening: str = "split", ends: str = "sweep", shared_memo: dict | None = None,
-                 mopup: str = "sequenced") -> None:
-        self.lg, self.cov, self.start, self.goal, self.paper, self.ends = lg, cov, start, goal, paper, ends
-        self.mopup = mopup
+                 region_columns: int, budget: int, deadline: float | None, memo: bool,
+                 additions=tuple(STRIPES_ADDITIONS), widening: str = "split", ends: str = "sweep",
+                 shared_memo: dict | None = None, mopup: str = "sequenced") -> None:
+        self.lg, self.cov, self.start, self.goal, self.ends = lg, cov, start, goal, ends
+        on = set(additions)
+        # each addition of ours, on or off (STRIPES_ADDITIONS); all off: the paper's Alg. 5
+        self.fixed, self.best_first = "fixed-regions" in on, "best-first" in on
+        self.fallback, self.split_sweeps = "greedy-fallback" in on, "split-sweeps" in on
+        self.reorder, self.shortest = "sweep-order" in on, "shortest-joins" in on
+        self.mopup = mopup if "mopup" in on else None
+        self.failed: dict = {}  # region searches that spent their budget without greedy-fallback, by region
         self.region_columns, self.budget, self.deadline, self.use_memo = region_columns, budget, deadline, memo
         n = lg.n_nodes
         ids = np.arange(n)
@@ -351,7 +359,7 @@ class _Planner:
                 break
         if joined is None:
             return [best[1:]]
-        if self.paper or joined[0] == best[1]:
+        if not self.split_sweeps or joined[0] == best[1]:
             return [joined]
         return [best[1:], joined]
 
@@ -387,12 +395,12 @@ class _Planner:
         mid = lo + (hi - lo + 1) // 2
         sweep.layouts = {}
         for d in directions:
-            for offset in ((0,) if self.paper else self._offsets()):
+            for offset in (self._offsets() if self.fixed else (0,)):
                 blocks, cuts = self._layout(sweep, d, offset)
                 chain = (blocks, cuts, [(d, (lo, hi))] * len(blocks))
                 if not any(_same_chain(chain, other) for other in sweep.layouts.values()):
                     sweep.layouts[(d, offset, 0)] = chain  # a narrow sweep may give one chain twice
-                if self.ends == "sweep" or self.paper or mid >= hi:
+                if self.ends == "sweep" or not self.fixed or mid >= hi:
                     continue
                 turn = np.array(self._ports(sweep, d, every=True), dtype=np.int64)
                 back, back_cuts = self._layout(sweep, -d, offset)
@@ -405,8 +413,8 @@ class _Planner:
         (default variant) one cut grid: cuts at ``offset``, ``offset + region_columns``, … columns
         from the sweep's start."""
         w, rc = self.lg.width, self.region_columns
-        forced = self._forced(sweep) if self.paper else None
-        if self.paper:  # cut only at forced poses: blocks start at their columns, along the sweep
+        forced = None if self.fixed else self._forced(sweep)
+        if not self.fixed:  # the paper's: cut only at forced poses, blocks starting at their columns, along the sweep
             edges = [c for c in sorted(set(self.bx[forced].tolist())) if 0 < c < w]
             if direction < 0:
                 edges = [c + 1 for c in edges if c + 1 < w]
@@ -416,13 +424,13 @@ class _Planner:
             bounds = sorted({0, w} | set(range(offset, w, rc)))
             blocks = [(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
         if direction < 0:
-            blocks = blocks[::-1] if self.paper else [(w - c1, w - c0) for c0, c1 in blocks]
+            blocks = [(w - c1, w - c0) for c0, c1 in blocks] if self.fixed else blocks[::-1]
         bx = self.bx[sweep.nodes]
         merged, cuts = [blocks[0]], []
         for block in blocks[1:]:
             column = block[0] if direction > 0 else block[1] - 1
             ports = sweep.nodes[bx == column]
-            if self.paper:
+            if not self.fixed:
                 ports = ports[np.isin(ports, forced)]
             if len(ports):
                 cuts.append(ports)
@@ -501,7 +509,7 @@ class _Planner:
         lg = self.lg
         c0, c1 = stripe.layouts[layout][0][b]
         xs = [self.bx[entry]] + [self.bx[e] for e in exits if e >= 0]
-        margin = lg.width if self.paper else WINDOW_MARGIN  # the paper's regions: the whole stripe
+        margin = WINDOW_MARGIN if self.fixed else lg.width  # the paper's regions: the whole stripe
         x0 = min(c0, *xs) - margin
         x1 = max(c1 - 1, *xs) + margin
         nodes = stripe.nodes[(self.bx[stripe.nodes] >= x0) & (self.bx[stripe.nodes] <= x1)]
@@ -524,7 +532,7 @@ class _Planner:
         band_lo = stripe.band[0]
         rel = (nodes // (lg.width * lg.height)) * 10**6 + (self.by[nodes] - band_lo) * width + (self.bx[nodes] - x0)
         memo_key = (width, rel.tobytes(), sub.indptr.tobytes(), sub.indices.tobytes(), sub.data.tobytes(), bits,
-                    direction if self.paper else 0)  # the paper's search orders its moves by the sweep
+                    0 if self.best_first else direction)  # the paper's search orders its moves by the sweep
         dist, pred = dijkstra(sub, return_predecessors=True)
         adjacency = tuple(
             tuple(zip(sub.indices[sub.indptr[v]:sub.indptr[v + 1]].tolist(),
@@ -550,25 +558,41 @@ class _Planner:
                 return None
             e_local, x_local = local[entry], (local[exit] if exit >= 0 else None)
             full_key = (memo_key, e_local, x_local)
+            # the fallback is in the key: a failed search is a result, not a walk another planner may take
+            full_key = full_key + (self.fallback,)
+            late = False
             if self.use_memo and full_key in self.memo:
                 self.stats["memo_hits"] += 1
-                result = self.memo[full_key]
+                result, late = self.memo[full_key]
             else:
                 if self.deadline is not None and time.perf_counter() > self.deadline:
-                    self.time_limited = True
-                    result = greedy_walk(region, e_local, x_local)
+                    self.time_limited = late = True
+                    result = greedy_walk(region, e_local, x_local) if self.fallback else \
+                        RegionResult(0, (), False, 0, exhausted=True)
                 else:
-                    search = search_inserting if self.paper else search_region
-                    result = search(region, e_local, x_local, gain=self.lg.gain, budget=self.budget)
+                    search = search_region if self.best_first else search_inserting
+                    result = search(region, e_local, x_local, gain=self.lg.gain, budget=self.budget,
+                                    fallback=self.fallback)
                 self.stats["regions"] += 1
                 if result is not None:
                     self.stats["optimal"] += bool(result.optimal)
                     self.stats["nodes"] += result.nodes
-                self.memo[full_key] = result
+                self.memo[full_key] = (result, late)
+            if result is not None and result.exhausted:  # the paper's search not run to its end: the region fails
+                self.failed[key] = self._failure(sweep, layout, b, entry, exit, result, late)
+                result = None
             self.results[key] = None if result is None else (result.cost, [int(nodes[v]) for v in result.path],
-                                                             dropped)
+                                                             dropped + result.missing.bit_count())
         found = self.results[key]
         return None if found is None else found[0] + DROP_PENALTY * found[2]
+
+    def _failure(self, sweep: _Sweep, layout, b: int, entry: int, exit: int, result, late: bool) -> dict:
+        """A failed region search as the result lists it (JSON-ready)."""
+        c0, c1 = sweep.layouts[layout][0][b]
+        return {"stripe": sweep.stripe, "rows": list(sweep.own), "columns": [int(c0), int(c1)],
+                "direction": int(layout[0]), "entry": self.lg.pose(entry).as_dict(),
+                "exit": None if exit < 0 else self.lg.pose(exit).as_dict(),
+                "reason": "time limit" if late else "node budget", "nodes": int(result.nodes)}
 
     # --- the DAG ------------------------------------------------------------------------------
     def _legs(self, g: nx.DiGraph, outs: list[int], intos: list[int], tail, head, a=None, b=None) -> list[int]:
@@ -577,7 +601,7 @@ class _Planner:
         cut-edges (translations in one layer through both bands, Def. 9) and falls back on those paths
         only where a stripe's pieces have none. Returns the ports reached."""
         reached = []
-        if self.paper and a is not None and b.stripe == a.stripe + 1:
+        if not self.shortest and a is not None and b.stripe == a.stripe + 1:
             rows = (min(a.band[0], b.band[0]), max(a.band[1], b.band[1]))
             hw = self.lg.width * self.lg.height
             for layer in range(self.lg.n_layers):
@@ -703,7 +727,7 @@ class _Planner:
         way to the goal: a cheaper path may leave more to the mop-up), until none does or
         :data:`ORDER_TRIES` orders have been tried. Returns the orders tried."""
         n = len(self.sweeps)
-        if self.paper or not 2 <= n <= ORDER_SWEEPS:
+        if not self.reorder or not 2 <= n <= ORDER_SWEEPS:
             return 0
 
         def cost(order) -> float:  # the plan's: the DAG's path, then the mop-up and the way to the goal
@@ -757,15 +781,16 @@ class _Planner:
 
     def plan(self) -> StripeOutcome:
         info: dict = {"sweeps": len(self.sweeps)}
+        then = "the whole map is covered by the mop-up walk" if self.mopup else "nothing is covered"
         if not self.sweeps:
-            info["dag"] = "no stripe has a piece: the whole map is covered by the mop-up walk"
+            info["dag"] = f"no stripe has a piece: {then}"
             return self._outcome([self.start], None, 0, info)
         info["order_tries"] = self._improve_order()
         g = self.dag(self.sweeps, start=self.start, goal=self.goal)
         info.update({"dag_nodes": g.number_of_nodes(), "dag_edges": g.number_of_edges()})
         dag_cost, dag_path = self._solve(g)
         if dag_path is None:
-            info["dag"] = "no path: the whole map is covered by the mop-up walk"
+            info["dag"] = f"no path: {then}"
             return self._outcome([self.start], None, 0, info)
         path, joins = self._vertex_path(g, dag_path), 0
         for u, v in zip(dag_path[:-1], dag_path[1:]):
@@ -795,13 +820,21 @@ class _Planner:
         info["order"] = [[sw.stripe, sw.direction] for sw in self.sweeps]
         info["widening"] = self.widening
         return StripeOutcome(path, dag_cost, transit, details, self.stats["regions"], self.stats["optimal"],
-                             self.stats["memo_hits"], self.stats["nodes"], self.time_limited, info)
+                             self.stats["memo_hits"], self.stats["nodes"], self.time_limited, info,
+                             dict(self.failed))
 
 
 def plan_total(lg: LayerGraph, cov: Coverability, path: list[int], dag_cost: float, goal: int | None,
-               mopup: str) -> float:
+               mopup: str | None) -> float:
     """Commands of a plan whose DAG path (costing ``dag_cost``) is ``path``: that, the mop-up, and the
-    way back to the goal if there is one."""
+    way back to the goal if there is one. Without a mop-up (None) a coverable cell left uncovered costs
+    :data:`DROP_PENALTY`, so that a plan covering more wins first."""
+    if mopup is None:
+        covered = np.zeros(lg.width * lg.height, dtype=bool)
+        covered[lg.footprint[path].ravel()] = True
+        left = int((cov.coverable.reshape(-1) & ~covered).sum())
+        back = 0.0 if goal is None or path[-1] == goal else shortest_path(lg, path[-1], goal)[0]
+        return DROP_PENALTY * left + dag_cost + back
     walk = [path[-1]] + mop_up(lg, path, cov.coverable, cov.reachable, order=mopup, goal=goal)
     back = 0.0 if goal is None or walk[-1] == goal else shortest_path(lg, walk[-1], goal)[0]
     return dag_cost + len(lg.commands_of(walk)) + back
@@ -814,10 +847,15 @@ def _same_chain(a: tuple, b: tuple) -> bool:
 
 
 def plan_stripes(lg: LayerGraph, cov: Coverability, start: int, goal: int | None, widths, *, region_columns: int,
-                 budget: int, deadline: float | None, memo: bool = True, paper: bool = False,
+                 budget: int, deadline: float | None, memo: bool = True, additions=tuple(STRIPES_ADDITIONS),
                  ends: str = "sweep", mopup: str = "sequenced") -> StripeOutcome:
     """The stripes' vertex path from ``start`` (to ``goal``, or a free end) along the auxiliary DAG's
     shortest path; the mop-up and the return to the goal are the caller's.
+
+    ``additions``: the names of :data:`~htetro_opt.solvers.coverage._spec.STRIPES_ADDITIONS` switched
+    on (all by default; none: the paper's Alg. 5). Without ``mopup`` the candidates below are compared
+    by the coverable cells their DAG paths leave, then by cost; without ``greedy-fallback`` a region
+    search that spends its budget fails and is listed in the outcome's ``failed``.
 
     Widening is cost-aware in the default variant: when a stripe split into pieces could also be
     joined by borrowing rows, the plan is made both ways (every split stripe swept piece by piece,
@@ -826,12 +864,15 @@ def plan_stripes(lg: LayerGraph, cov: Coverability, start: int, goal: int | None
     too (ties: ``"both"``): the both-ends DAG is a superset, so its path never costs more, but its
     mop-up may, and the plan must never cost more than ``"sweep"``'s. Every candidate shares one
     memo of region searches (keyed by content)."""
-    options = dict(region_columns=region_columns, budget=budget, deadline=deadline, memo=memo, paper=paper,
-                   shared_memo={}, mopup=mopup)
-    first = "joined" if paper else "split"
+    additions = tuple(additions)
+    mopup = mopup if "mopup" in additions else None
+    split = "split-sweeps" in additions
+    options = dict(region_columns=region_columns, budget=budget, deadline=deadline, memo=memo, additions=additions,
+                   shared_memo={}, mopup=mopup or "sequenced")
+    first = "split" if split else "joined"
     planner = _Planner(lg, cov, start, goal, widths, **options, widening=first, ends=ends)
     runs = {(first, ends): planner.plan()}
-    widenings = [first] + (["joined"] if not paper and planner.choices else [])
+    widenings = [first] + (["joined"] if split and planner.choices else [])
     for widening, e in [(w, e) for e in dict.fromkeys((ends, "sweep")) for w in widenings]:
         if (widening, e) not in runs:  # "both" keeps "sweep"'s plan as a candidate: never costlier with its mop-up
             runs[(widening, e)] = _Planner(lg, cov, start, goal, widths, **options, widening=widening, ends=e).plan()
@@ -853,4 +894,5 @@ def plan_stripes(lg: LayerGraph, cov: Coverability, start: int, goal: int | None
     for name in ("regions", "regions_optimal", "memo_hits", "nodes"):  # every plan's searches count
         setattr(best, name, sum(getattr(o, name) for o in runs.values()))
     best.time_limited = any(o.time_limited for o in runs.values())
+    best.failed = {k: v for o in runs.values() for k, v in o.failed.items()}  # every search of the run counts
     return best
