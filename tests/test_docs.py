@@ -344,7 +344,7 @@ def _run(capsys, argv):
 
 def test_there_is_a_json_example_of_every_command():
     commands = [argv[0] for argv, _ in _cli_examples()]
-    assert sorted(set(commands)) == ["plan", "sequence", "simulate", "tile"]
+    assert sorted(set(commands)) == ["cover", "plan", "sequence", "simulate", "tile"]
 
 
 @pytest.mark.parametrize("argv, documented", _cli_examples(), ids=lambda v: " ".join(v) if isinstance(v, list) else "")
@@ -353,7 +353,7 @@ def test_the_cli_prints_the_json_shown(examples, monkeypatch, capsys, argv, docu
     _same(documented, _run(capsys, argv))
 
 
-@pytest.mark.parametrize("command", ["plan", "simulate", "tile", "sequence"])
+@pytest.mark.parametrize("command", ["plan", "simulate", "tile", "sequence", "cover"])
 def test_the_field_tables_list_the_json_fields(command):
     _, rows = table(FORMATS, f"fields: {command}")
     documented = next(out for argv, out in _cli_examples() if argv[0] == command)
