@@ -62,6 +62,8 @@ def run(args) -> dict:
         late(out, lambda: save_plot(shown, lambda: plot_cover_heat(plan, title=title), args.coverage_plot))
     if not args.json:
         state = "complete" if plan.complete else f"incomplete ({len(plan.uncoverable)} free cells uncoverable)"
+        if not plan.success:  # the paper's algorithm left cells or ran out of nodes: said, not rescued
+            state = f"not successful: {plan.message}"
         print(f"{problem.name}: {method.name} with {','.join(plan.layers)}: {plan.action_cost} commands, {state}, "
               f"average coverage time {plan.average_coverage_time:.3f}, {plan.regions_optimal} of {plan.regions} "
               f"region searches optimal, {plan.runtime_s:.3f} s")

@@ -1,5 +1,15 @@
 """Cheng et al. 2019's stripe coverage (§III–IV): stripes, their pieces, regions and one auxiliary DAG.
 
+The paper's Alg. 5 (``stripes-paper``, no addition) and ours (``stripes``) are one planner: each of our
+departures is an addition of :data:`~htetro_opt.solvers.coverage._spec.STRIPES_ADDITIONS`, switched on
+singly. With none, a stripe is cut at its forced poses and each region searched in the whole stripe
+(``fixed-regions`` off) by the paper's depth-first search over simple paths with insertions
+(``best-first`` off); a split stripe is widened (``split-sweeps`` off); the sweeps keep their greedy
+order (``sweep-order`` off) and consecutive stripes are joined by cut-edges (``shortest-joins`` off); a
+search past its node budget or the time limit fails and is listed (``greedy-fallback`` off); and nothing
+visits what the stripes leave (``mopup`` off, the caller's). The paragraphs below are our readings of the
+paper with every addition on, each naming the addition a reading belongs to.
+
 Our reading of the paper, where it is ambiguous or contradicts itself:
 
 - **Stripes** (Def. 6–7) are bands of rows stacked from y = 0. A vertex belongs to stripe k when its
@@ -15,7 +25,7 @@ Our reading of the paper, where it is ambiguous or contradicts itself:
   one's exit, in either direction (ties: the lower stripe, the direction opposite to the last): on a
   map without splits this is the paper's boustrophedon of stripes (+x, −x, …); a room behind a
   doorway is covered whole before the robot goes back through it. Up to :data:`ORDER_SWEEPS`
-  sweeps, the default variant then improves that order by moving or reversing one sweep at a time
+  sweeps, the default variant (``sweep-order``) then improves that order by moving or reversing one sweep at a time
   while the whole DAG's cost drops (coverage_16x16 {vI, hI}: 190 → 173 commands).
 - **Widening** (Alg. 5 l. 14): when some of a stripe's targets lie under no vertex of its band, rows
   are borrowed one at a time, the previous stripe's first, at most as many as the stripe has (the
@@ -38,7 +48,7 @@ Our reading of the paper, where it is ambiguous or contradicts itself:
   weight callable of ``nx.single_source_dijkstra`` and memoised by the region's content (its window
   of vertices and edges relative to the window, targets, entry and exit), not by a cell (Alg. 1's
   ``WT`` keys by the vertex's cell only, which mixes different costs).
-- **Start, goal, mop-up**: the first sweep is in the lowest stripe (the one holding the start, else
+- **Start, goal, mop-up** (``mopup``): the first sweep is in the lowest stripe (the one holding the start, else
   the nearest); a start outside it reaches its entry ports (a goal outside the last sweep is reached
   from its exit ports) by shortest paths; without a goal the plan ends where the last region does.
   Cells the sweeps leave uncovered are visited afterwards (mop-up: nearest-first, then re-ordered by
