@@ -403,3 +403,22 @@ def test_the_one_command_line_refuses_bad_options(capsys):
     assert main(["study", "cheng2019", "--workers", "0"]) == 2
     assert "--workers" in capsys.readouterr().err
     assert not hasattr(cheng2019, "main")  # one command line: htetro-opt study
+
+
+def test_the_ablation_study_runs_the_paper_each_addition_alone_and_ours():
+    from htetro_opt.solvers.coverage import SPEC, STRIPES_ADDITIONS
+
+    study = load_study("cheng2019_ablation")
+    assert study.task == "cover" and study.metrics == ("gap",)
+    trials = study.trials()
+    configs = {(t.scenario, t.parameters["shapes"], str(t.parameters["stripes"])) for t in trials}
+    assert configs == {("coverage_16x16", "O", "4"), ("coverage_16x16", "O,vI,hI", "4"),
+                       ("coverage_16x7", "O,hI", "[2, 3, 2]")}
+    for config in configs:
+        mine = [t for t in trials if (t.scenario, t.parameters["shapes"], str(t.parameters["stripes"])) == config]
+        switched = [SPEC.check(t.method, {"additions": t.parameters.get("additions",
+                                                                         SPEC.default_of(t.method, "additions"))},
+                               fill=False)["additions"] for t in mine]
+        # the paper's algorithm, then each addition alone in STRIPES_ADDITIONS' order, then ours with all
+        assert [t.method for t in mine] == ["stripes-paper"] * (len(STRIPES_ADDITIONS) + 1) + ["stripes"]
+        assert switched == [()] + [(a,) for a in STRIPES_ADDITIONS] + [tuple(STRIPES_ADDITIONS)]
