@@ -18,6 +18,7 @@ from htetro_opt._lazy import attach
 __getattr__, __dir__, __all__ = attach(__name__, {
     "HTetroGA": ".htetro_ga", "trim_reached": ".htetro_ga", "check_additions": ".htetro_ga",
     "GA_ADDITIONS": ".names",
+    "EGA_ADDITIONS": ".names",
     "FrontConvergence": ".termination", "HypervolumeWindow": ".termination", "CONVERGENCE_MEASURES": ".names", "reaching_hypervolume": ".termination",
     "GA_ALGORITHMS": ".names", "make_algorithm": ".factory", "ReplanMating": ".factory",
     "ConservativeMating": ".factory",

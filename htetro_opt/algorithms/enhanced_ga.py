@@ -11,27 +11,30 @@ GA's. Each generation, from the PS members (sorted best first):
 2. n_m = ⌊0.15 PS + ½⌋ mutants, each of a uniformly drawn member by one of the three mutations
    (:class:`~htetro_opt.operators.path_bases.PathBasesMutation`);
 3. with several robots, collision removal of every conflicted child (§4.5);
-4. deletion (§4.2.4);
-5. the children equal to a member or to an earlier child dropped;
-6. the members and the new children merged, sorted stably feasible first, then by G, then by F (the
+4. deletion (§4.3.4) of one member drawn by the roulette (the paper's "an individual is selected from the
+   mating pool"), which is then one more child, its PBs assessed once each, left to right;
+5. the members and the new children merged, sorted stably feasible first, then by G, then by F (the
    paper's "large penalty" for infeasible paths), and cut to PS.
 
 The roulette's cost is F plus 10 (W + H) per unit of G (infeasible segments and conflicts), so that
-infeasible members are rarely parents.
+infeasible members are rarely parents. That is :meth:`EnhancedGA.as_published` (``additions=()``).
 
-Three additions of ours are on by default and off in :meth:`EnhancedGA.as_published`:
+Our additions (:data:`~htetro_opt.algorithms.EGA_ADDITIONS`), all on by default, each
+switched singly by ``additions``:
 
-- **deletion of every child** and of the initial paths (the paper deletes PBs of one roulette pick
-  per generation, which is then one more child);
-- **taut refinement** (:class:`~htetro_opt.operators.path_bases.TautRefinement`) of the initial
+- ``delete-every-child``: deletion of every child and of the initial paths, instead of step 4's one
+  roulette pick;
+- ``deletion-passes``: the deletion repeats its pass until one drops nothing;
+- ``straight-first``: the deletion first tries the straight start → goal segment;
+- ``child-dedup``: children equal to a member or to an earlier child are dropped after deletion
+  (before refinement, which would only rebuild them) and again after refinement, and duplicate
+  initial paths too (pymoo's duplicate elimination);
+- ``taut-refinement`` (:class:`~htetro_opt.operators.path_bases.TautRefinement`) of the initial
   paths and of each generation's best child: without it the EGA stalls a few per cent above the
   optimum on mazes, short of the wall corners (refining every child found nothing more on the twelve
   maps, in up to twice the time);
-- **a finer APF** for half the initial population (lattice step d / 2): the d = 1 lattice misses
-  gaps narrower than 1, and with them the shortest way through ``ega12_plankpile``.
-
-Children equal to a member or to an earlier child are dropped after deletion (before refinement,
-which would only rebuild them) and again after refinement.
+- ``finer-apf``: half the initial population from the APF's lattice at step d / 2: the d = 1
+  lattice misses gaps narrower than 1, and with them the shortest way through ``ega12_plankpile``.
 
 :func:`make_path_algorithm` gives pymoo's NSGA-II, NSGA-III, SMS-EMOA or AGE-MOEA with the same
 sampling, crossover, mutation and duplicate elimination, deletion as their repair (the command
@@ -45,10 +48,13 @@ import math
 
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
+from pymoo.core.duplicate import NoDuplicateElimination
 from pymoo.core.population import Population
 
-from htetro_opt._validation import check_bool, check_int, check_probability, check_real
+from htetro_opt._spec import additions as additions_check
+from htetro_opt._validation import check_int, check_probability, check_real
 from htetro_opt.algorithms.factory import _pymoo_algorithm
+from htetro_opt.algorithms.names import EGA_ADDITIONS
 from htetro_opt.errors import ParameterError
 from htetro_opt.operators.path_bases import (
     CollisionRemoval,
@@ -66,6 +72,9 @@ __all__ = ["EnhancedGA", "make_path_algorithm", "PATH_ALGORITHMS", "feasibility_
 
 PATH_ALGORITHMS = ("ega", "ega-paper", "nsga2", "nsga3", "smsemoa", "agemoea")
 """Algorithm names :func:`make_path_algorithm` knows."""
+
+
+_check_additions = additions_check(EGA_ADDITIONS)
 
 
 def feasibility_order(F: np.ndarray, G: np.ndarray) -> np.ndarray:
@@ -94,25 +103,23 @@ class EnhancedGA(GeneticAlgorithm):
         0.35 and 0.15: n_c = 2 ⌊crossover_share · PS / 2 + ½⌋ children, n_m = ⌊mutation_share · PS + ½⌋ mutants.
     selection_pressure : float
         β of the roulette's P ∝ exp(−β c / c_worst) (8).
-    delete_children : bool
-        Ours: delete PBs of every child and initial path; False: of one roulette pick per generation
-        (the paper).
-    refine : bool
-        Ours: taut refinement of the initial paths and of each generation's best child.
-    finer_apf : bool
-        Ours: half the initial paths from the APF's lattice at half the step (used when ``sampling``
-        is not given; see :func:`~htetro_opt.operators.path_bases.initial_paths`).
+    additions : collection of str
+        Our additions switched on (names of :data:`~htetro_opt.algorithms.EGA_ADDITIONS`;
+        default all; ``()``: the paper's EGA). ``finer-apf`` acts only when ``sampling`` is not given
+        (see :func:`~htetro_opt.operators.path_bases.initial_paths`).
     collision_tries : int
         Moves tried per conflicted child with several robots (§4.5; 20).
 
     Raises
     ------
     ParameterError
-        If ``pop_size`` is below 2, a share is not in [0, 1], the pressure is negative, a switch is
-        not a bool, or ``collision_tries`` is negative.
+        If ``pop_size`` is below 2, a share is not in [0, 1], the pressure is negative, an addition
+        is unknown, or ``collision_tries`` is negative.
 
     Attributes
     ----------
+    additions : tuple of str
+        The additions switched on, in :data:`EGA_ADDITIONS`' order.
     history : list of float
         The best member's cost after each generation (the initial population first).
 
@@ -130,16 +137,17 @@ class EnhancedGA(GeneticAlgorithm):
 
     def __init__(self, pop_size: int = 10, *, sampling=None, crossover=None, mutation=None,
                  crossover_share: float = 0.35, mutation_share: float = 0.15, selection_pressure: float = 8.0,
-                 delete_children: bool = True, refine: bool = True, finer_apf: bool = True, collision_tries: int = 20,
-                 **kwargs) -> None:
+                 additions=tuple(EGA_ADDITIONS), collision_tries: int = 20, **kwargs) -> None:
         pop_size = check_int(pop_size, "pop_size", minimum=2)
-        finer_apf = check_bool(finer_apf, "finer_apf")
+        self.additions = _check_additions(additions, "additions")
+        on = set(self.additions)
         super().__init__(
             pop_size=pop_size,
-            sampling=sampling if sampling is not None else PathBasesSampling(finer=finer_apf),
+            sampling=sampling if sampling is not None else PathBasesSampling(finer="finer-apf" in on),
             crossover=crossover if crossover is not None else PathBasesCrossover(),
             mutation=mutation if mutation is not None else PathBasesMutation(),
-            eliminate_duplicates=PathBasesDuplicateElimination(),
+            # the paper keeps every path, copies included (child-dedup off: pymoo's no-op elimination)
+            eliminate_duplicates=PathBasesDuplicateElimination() if "child-dedup" in on else NoDuplicateElimination(),
             advance_after_initial_infill=True,
             **kwargs,
         )
@@ -148,23 +156,22 @@ class EnhancedGA(GeneticAlgorithm):
         self.crossover_share = check_probability(crossover_share, "crossover_share")
         self.mutation_share = check_probability(mutation_share, "mutation_share")
         self.selection_pressure = check_real(selection_pressure, "selection_pressure", minimum=0.0)
-        self.delete_children = check_bool(delete_children, "delete_children")
-        self.refine = check_bool(refine, "refine")
-        self.finer_apf = finer_apf
+        self.delete_children = "delete-every-child" in on
+        self.refine = "taut-refinement" in on
+        self.finer_apf = "finer-apf" in on
+        self.dedup = "child-dedup" in on
         self.collision_tries = check_int(collision_tries, "collision_tries", minimum=0)
-        self.deletion = PathBasesDeletion()
+        self.deletion = PathBasesDeletion(passes="deletion-passes" in on, straight="straight-first" in on)
         self.refinement = TautRefinement()
         self.collision_removal = CollisionRemoval(self.collision_tries)
         self.history: list[float] = []
 
     @classmethod
-    def as_published(cls, pop_size: int = 10, **kwargs) -> EnhancedGA:
-        """The EGA without our additions: deletion of one roulette pick per generation, no taut
-        refinement, the APF on the lattice of step d only. A keyword given here switches one back on
-        (e.g. ``refine=True``)."""
-        options = dict(delete_children=False, refine=False, finer_apf=False)
-        options.update(kwargs)
-        return cls(pop_size, **options)
+    def as_published(cls, pop_size: int = 10, *, additions=(), **kwargs) -> EnhancedGA:
+        """The EGA without our additions: deletion of one roulette pick per generation in one pass,
+        every child kept, no taut refinement, the APF on the lattice of step d only. ``additions``
+        switches some back on (e.g. ``("taut-refinement",)``)."""
+        return cls(pop_size, additions=additions, **kwargs)
 
     @property
     def n_children(self) -> int:
@@ -227,14 +234,14 @@ class EnhancedGA(GeneticAlgorithm):
         elif not self.delete_children:
             pick = Population.new("X", as_column([X[int(self._roulette(1)[0])]]))
             off = Population.merge(off, self.deletion.do(problem, pick))
-        seen = {path_key(x) for x in X}
-        off = self._new(off, seen)
+        off = self._new(off, {path_key(x) for x in X}) if self.dedup else (off if len(off) else None)
         if self.refine and off is not None:
             G, F = problem.score(list(off.get("X")[:, 0]))
             k = int(feasibility_order(F, G)[0])
             rest = [i for i in range(len(off)) if i != k]
             off = Population.merge(off[rest], self.refinement.do(problem, off[[k]]))
-            off = self._new(off, {path_key(x) for x in X})
+            if self.dedup:
+                off = self._new(off, {path_key(x) for x in X})
         return off
 
     @staticmethod
@@ -283,8 +290,8 @@ def make_path_algorithm(name: str = "ega", pop_size: int = 10, *, sampling=None)
 
     Examples
     --------
-    >>> type(make_path_algorithm("smsemoa", 12)).__name__, make_path_algorithm("ega-paper").refine
-    ('SMSEMOA', False)
+    >>> type(make_path_algorithm("smsemoa", 12)).__name__, make_path_algorithm("ega-paper").additions
+    ('SMSEMOA', ())
     """
     if name not in PATH_ALGORITHMS:
         raise ParameterError(f"unknown algorithm {name!r}: expected one of {', '.join(PATH_ALGORITHMS)}")

@@ -1,10 +1,11 @@
-"""The names the GAs over command chromosomes take, as plain data: importing them loads no pymoo, so
-that the grid-path task's spec (``htetro_opt.solvers.grid_paths._spec``) and the command line can
-offer them as choices."""
+"""The names the GAs over command chromosomes and the enhanced GA over path bases take, as plain data:
+importing them loads no pymoo, so that the grid-path and continuous tasks' specs
+(``htetro_opt.solvers.grid_paths._spec``, ``htetro_opt.solvers.continuous._spec``) and the command
+line can offer them as choices."""
 
 from __future__ import annotations
 
-__all__ = ["CONVERGENCE_MEASURES", "GA_ADDITIONS", "GA_ALGORITHMS", "PICKS", "SELECTIONS"]
+__all__ = ["CONVERGENCE_MEASURES", "EGA_ADDITIONS", "GA_ADDITIONS", "GA_ALGORITHMS", "PICKS", "SELECTIONS"]
 
 GA_ALGORITHMS = ("htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea")
 """Algorithm names :func:`~htetro_opt.algorithms.make_algorithm` knows: the hTetro-GA with our
@@ -41,3 +42,21 @@ GA_ADDITIONS = {
 """The hTetro-GA's additions of ours to Cheng et al. 2020's algorithm, by name, each switchable
 (:meth:`~htetro_opt.algorithms.HTetroGA.with_additions`): ``htetro-ga`` has them all, ``htetro-ga-paper``
 none."""
+
+EGA_ADDITIONS = {
+    "delete-every-child": "deletion runs on every child and on the initial paths; the paper deletes the PBs of one "
+                          "roulette pick per generation, which is then one more child",
+    "deletion-passes": "deletion repeats its left-to-right pass until a pass drops nothing; the paper assesses each "
+                       "PB of the path once, in order (§4.3.4)",
+    "straight-first": "deletion first tries the straight start-goal segment, kept when it is feasible and no "
+                      "costlier; the paper only deletes PBs one at a time",
+    "child-dedup": "children equal to a member or to an earlier child are dropped (and duplicate initial paths); "
+                   "the paper keeps every child",
+    "taut-refinement": "the initial paths and each generation's best child are pulled taut by an exact "
+                       "visibility-graph search over their own PBs and the wall corners within 2 d of them",
+    "finer-apf": "half the initial paths come from the APF lattice at half the step, d / 2; the paper's APF runs "
+                 "at d only",
+}
+"""Our additions to Nazarahari et al. 2019's enhanced GA (§4.3), by name (:class:`~htetro_opt.algorithms.EnhancedGA`):
+the continuous task's ``ega`` runs them all, ``ega-paper`` (the paper's) none; each is switched on or off singly by
+the ``additions`` option (docs/papers/nazarahari2019.md)."""

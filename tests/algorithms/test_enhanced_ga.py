@@ -7,7 +7,7 @@ import pytest
 from pymoo.optimize import minimize
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-from htetro_opt.algorithms import PATH_ALGORITHMS, EnhancedGA, make_path_algorithm
+from htetro_opt.algorithms import EGA_ADDITIONS, PATH_ALGORITHMS, EnhancedGA, make_path_algorithm
 from htetro_opt.errors import ParameterError
 from htetro_opt.problems import PathBasesProblem
 from htetro_opt.scenarios import load_scenario
@@ -18,9 +18,11 @@ def test_offspring_counts_follow_the_yarpiz_ga():
     assert (ga.n_children, ga.n_mutants) == (4, 2)  # 2⌊0.35·10/2 + ½⌋, ⌊0.15·10 + ½⌋
     assert (EnhancedGA(50).n_children, EnhancedGA(50).n_mutants) == (18, 8)
     paper = EnhancedGA.as_published(10)
-    assert (paper.delete_children, paper.refine, paper.finer_apf) == (False, False, False)
-    assert (ga.delete_children, ga.refine, ga.finer_apf) == (True, True, True)
-    assert EnhancedGA.as_published(10, refine=True).refine
+    assert paper.additions == () and (paper.delete_children, paper.refine, paper.finer_apf, paper.dedup) == (
+        False, False, False, False)
+    assert ga.additions == tuple(EGA_ADDITIONS) and (ga.delete_children, ga.refine, ga.finer_apf, ga.dedup) == (
+        True, True, True, True)
+    assert EnhancedGA.as_published(10, additions=["taut-refinement"]).refine
     assert make_path_algorithm("ega").initialization.sampling.finer
     assert not make_path_algorithm("ega-paper").initialization.sampling.finer
 
@@ -53,8 +55,8 @@ def test_bad_settings_raise_typed_errors():
         EnhancedGA(1)
     with pytest.raises(ParameterError, match="crossover_share"):
         EnhancedGA(10, crossover_share=1.5)
-    with pytest.raises(ParameterError, match="refine"):
-        EnhancedGA(10, refine=1)
+    with pytest.raises(ParameterError, match="unknown addition 'refine'"):
+        EnhancedGA(10, additions=["refine"])
     problem = PathBasesProblem(load_scenario("ega04_corridor1"), objectives="separate")
     with pytest.raises(ParameterError, match="one objective"):
         minimize(problem, EnhancedGA(10), ("n_gen", 2), seed=0)

@@ -1,4 +1,4 @@
-"""Nazarahari et al. 2019's two crossovers of path bases (§4.2.2, eqs. 1 and 2).
+"""Nazarahari et al. 2019's two crossovers of path bases (§4.3.2, eqs. 1 and 2).
 
 Parents with equally many PBs are combined PB by PB; otherwise each PB of the parent with fewer is
 paired with the nearest PB of the other (the paper), and the child has as many PBs as that parent.

@@ -1,11 +1,18 @@
-"""Nazarahari et al. 2019's deletion operator (§4.2.4): redundant path bases dropped.
+"""Nazarahari et al. 2019's deletion operator (§4.3.4): redundant path bases dropped.
 
-The PBs are assessed left to right: one is dropped when that is beneficial, i.e. the path stays
-feasible and its cost does not rise, or, for an infeasible path, its infeasible segments become
-fewer. Ours, where the paper is silent: passes repeat until one drops nothing (so the operator is
-idempotent), and a feasible straight start → goal segment whose cost does not rise replaces the
-path first (left-to-right deletion alone can stall on two PBs that each hide the other's
-neighbour).
+The paper: "the deletion operator assesses each PB sequentially. If the deletion of any chosen PB is
+beneficial (turns an infeasible path to a feasible one, reduces the path length, increases the path
+smoothness), the deletion operator deletes it." Our reading: the PBs are assessed once each, left to
+right, each against the path as the earlier deletions left it; a deletion is beneficial when the
+path stays feasible and its cost does not rise, or, for an infeasible path, when its infeasible
+segments become fewer (the cost's "large penalty" falls; once none is left the feasible rule
+applies to the PBs still to come). That is ``passes=False, straight=False``.
+
+Two additions of ours, on by default (:data:`~htetro_opt.solvers.continuous._spec.EGA_ADDITIONS`):
+``passes`` (``deletion-passes``) repeats the pass until one drops nothing, so the operator is
+idempotent; ``straight`` (``straight-first``) first replaces a feasible path by the straight
+start → goal segment when that is no costlier (left-to-right deletion alone can stall on two PBs
+that each hide the other's neighbour).
 
 By default the path is the polyline through its PBs and its cost is its length, which a deletion
 never raises (the triangle inequality): only feasibility decides, and each step checks one segment.
@@ -33,7 +40,7 @@ def _not_worse(new, old) -> bool:
 
 
 def delete_path_bases(pbs, start, goal, geometry: ContinuousGeometry | None = None, *,
-                      judge: Callable | None = None) -> np.ndarray:
+                      judge: Callable | None = None, passes: bool = True, straight: bool = True) -> np.ndarray:
     """The PBs left after deletion (see the module docstring).
 
     Parameters
@@ -45,6 +52,10 @@ def delete_path_bases(pbs, start, goal, geometry: ContinuousGeometry | None = No
     judge : callable, keyword-only, optional
         ``judge(pbs) -> (bad, cost)``: the number of infeasible segments (or any violation count) and
         the cost (a number, or an array: then no entry may rise) of a candidate. Replaces the default.
+    passes : bool, keyword-only
+        Ours: repeat the left-to-right pass until one drops nothing; False: one pass (the paper).
+    straight : bool, keyword-only
+        Ours: first try the straight start → goal segment; False: PBs are only deleted one at a time.
 
     Returns
     -------
@@ -56,6 +67,11 @@ def delete_path_bases(pbs, start, goal, geometry: ContinuousGeometry | None = No
     >>> pbs = np.array([[2.0, 8.0], [4.0, 8.0], [5.0, 9.0], [6.0, 8.0], [8.0, 5.0]])
     >>> delete_path_bases(pbs, [1, 1], [9, 1], geo).tolist()
     [[4.0, 8.0], [6.0, 8.0]]
+    >>> zigzag = np.array([[2.0, 7.0], [7.0, 10.0], [2.0, 10.0], [8.0, 9.0]])
+    >>> delete_path_bases(zigzag, [1, 1], [9, 1], geo, passes=False, straight=False).tolist()  # the paper's pass
+    [[2.0, 7.0], [2.0, 10.0], [8.0, 9.0]]
+    >>> delete_path_bases(zigzag, [1, 1], [9, 1], geo).tolist()  # passes until none drops a PB
+    [[2.0, 10.0], [8.0, 9.0]]
     """
     start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
     pbs = np.array(pbs, dtype=float).reshape(-1, 2)
@@ -64,9 +80,11 @@ def delete_path_bases(pbs, start, goal, geometry: ContinuousGeometry | None = No
     if judge is None:
         if geometry is None:
             raise TypeError("delete_path_bases needs a geometry or a judge")
-        return _delete_polyline(pbs, start, goal, geometry)
+        if not passes:
+            return _one_pass(pbs, start, goal, geometry, straight=straight)
+        return _delete_polyline(pbs, start, goal, geometry, straight=straight)
     bad, cost = judge(pbs)
-    if bad == 0:
+    if bad == 0 and straight:
         empty = np.empty((0, 2))
         b, c = judge(empty)
         if b == 0 and _not_worse(c, cost):
@@ -74,22 +92,46 @@ def delete_path_bases(pbs, start, goal, geometry: ContinuousGeometry | None = No
     changed = True
     while changed and len(pbs):
         changed, i = False, 0
-        while i < len(pbs):
+        while i < len(pbs):  # a PB dropped: the next one moves into place i, so each is assessed once
             candidate = np.delete(pbs, i, axis=0)
             b, c = judge(candidate)
             if (b == 0 and _not_worse(c, cost)) if bad == 0 else b < bad:
-                if bad > 0 and b == 0:  # feasible now: start again under the feasible rule
-                    return delete_path_bases(candidate, start, goal, judge=judge)
+                if bad > 0 and b == 0 and passes:  # feasible now: start again under the feasible rule
+                    return delete_path_bases(candidate, start, goal, judge=judge, straight=straight)
                 pbs, bad, cost, changed = candidate, b, c, True
             else:
                 i += 1
+        if not passes:
+            break
     return pbs
 
 
-def _delete_polyline(pbs: np.ndarray, start: np.ndarray, goal: np.ndarray, geometry: ContinuousGeometry) -> np.ndarray:
+def _one_pass(pbs: np.ndarray, start: np.ndarray, goal: np.ndarray, geometry: ContinuousGeometry, *,
+              straight: bool) -> np.ndarray:
+    """The paper's deletion on the polyline start → PBs → goal under its length: each PB assessed once, left to
+    right, against the last PB kept (one segment test per PB)."""
     points = np.vstack([start, pbs, goal])
     ok = geometry.path_segments_feasible(points)
-    if ok.all() and geometry.segments_feasible(start[None], goal[None])[0]:
+    if straight and ok.all() and geometry.segments_feasible(start[None], goal[None])[0]:
+        return np.empty((0, 2))
+    bad = int((~ok).sum())
+    kept, left_ok = [0], bool(ok[0])  # left_ok: the segment from the last kept point to point k
+    for k in range(1, len(points) - 1):
+        link = bool(geometry.segments_feasible(points[kept[-1]][None], points[k + 1][None])[0])
+        after = bad - int(not left_ok) - int(not ok[k]) + int(not link)
+        if link if bad == 0 else after < bad:  # feasible: the length never rises (triangle inequality)
+            bad, left_ok = after, link
+        else:
+            kept.append(k)
+            left_ok = bool(ok[k])
+    return points[kept[1:]].copy()
+
+
+def _delete_polyline(pbs: np.ndarray, start: np.ndarray, goal: np.ndarray, geometry: ContinuousGeometry, *,
+                     straight: bool = True) -> np.ndarray:
+    points = np.vstack([start, pbs, goal])
+    ok = geometry.path_segments_feasible(points)
+    if straight and ok.all() and geometry.segments_feasible(start[None], goal[None])[0]:
         return np.empty((0, 2))
     while len(points) > 2:
         # every candidate's joining segment at once: a pass that would drop nothing is not run
@@ -113,7 +155,7 @@ def _delete_polyline(pbs: np.ndarray, start: np.ndarray, goal: np.ndarray, geome
                 ok = np.concatenate([ok[:i - 1], [link], ok[i + 1:]])
                 joined = None  # the next candidate's left neighbour moved
                 if ok.all():  # feasible now: start again under the feasible rule
-                    return _delete_polyline(points[1:-1], start, goal, geometry)
+                    return _delete_polyline(points[1:-1], start, goal, geometry, straight=straight)
             else:
                 i += 1
                 if joined is None:
@@ -153,23 +195,33 @@ class PathBasesDeletion(Repair):
     ``"separate"`` objectives' first) takes the segment-by-segment default; otherwise each candidate
     is judged by the problem: G (infeasible segments and robot conflicts) and the cost (eq. 6 with
     the robots' penalty; in ``"separate"`` mode all three objectives, none of which may rise).
+
+    Parameters
+    ----------
+    passes, straight : bool
+        Our two additions (see :func:`delete_path_bases`); both False: the paper's single pass.
     """
+
+    def __init__(self, *, passes: bool = True, straight: bool = True) -> None:
+        super().__init__()
+        self.passes, self.straight = bool(passes), bool(straight)
 
     def _do(self, problem, X, **kwargs):
         Y = np.empty((len(X), 1), dtype=object)
         for i in range(len(X)):
-            Y[i, 0] = delete_chromosome(problem, X[i, 0])
+            Y[i, 0] = delete_chromosome(problem, X[i, 0], passes=self.passes, straight=self.straight)
         return Y
 
 
-def delete_chromosome(problem, x):
+def delete_chromosome(problem, x, *, passes: bool = True, straight: bool = True):
     """One chromosome of ``problem`` after deletion, robot by robot (see :class:`PathBasesDeletion`)."""
     parts = problem.robots(x)
     plain = problem.n_robots == 1 and problem.path == "linear" and (
         problem.objectives == "weighted" and problem.weights[1:] == (0.0, 0.0))
     for k in range(len(parts)):
         if plain:
-            parts[k] = delete_path_bases(parts[k], problem.starts[k], problem.goals[k], problem.geometry)
+            parts[k] = delete_path_bases(parts[k], problem.starts[k], problem.goals[k], problem.geometry,
+                                         passes=passes, straight=straight)
             continue
 
         def judge(candidate, k=k):
@@ -178,5 +230,6 @@ def delete_chromosome(problem, x):
             G, F = problem.score([problem.join(trial)])
             return G[0], (F[0] if problem.objectives == "separate" else F[0, 0])
 
-        parts[k] = delete_path_bases(parts[k], problem.starts[k], problem.goals[k], judge=judge)
+        parts[k] = delete_path_bases(parts[k], problem.starts[k], problem.goals[k], judge=judge, passes=passes,
+                                     straight=straight)
     return problem.join(parts)

@@ -1,4 +1,4 @@
-"""Nazarahari et al. 2019's three mutations of path bases (§4.2.3).
+"""Nazarahari et al. 2019's three mutations of path bases (§4.3.3).
 
 Each moves k = max(1, ⌊0.2 n + ½⌋) of a path's n PBs (the paper's mutation rate 0.2; a path without
 PBs is left as it is), drawn without replacement:

@@ -23,6 +23,7 @@ from htetro_opt.solvers.continuous._spec import SPEC
 __all__ = ["plan_ega", "plan_ega_paper", "plan_moea", "plan_nsga2", "MOEA_ALGORITHMS"]
 
 _EGA, _MOEA = SPEC.defaults("ega"), SPEC.defaults("nsga2")  # the task's defaults, declared once in its spec
+_PAPER = SPEC.defaults("ega-paper")
 
 MOEA_ALGORITHMS = ("nsga2", "nsga3", "smsemoa", "agemoea")
 """pymoo's algorithms :func:`plan_moea` runs over path bases."""
@@ -56,16 +57,15 @@ def _best(problem: PathBasesProblem, xs: list):
     return xs[int(order[0])]
 
 
-def _run_ga(scenario, *, variant: str, path: str, weights, safety: str, grid: float, pop_size: int,
-            max_gen: int, rng) -> tuple[list, list, dict]:
+def _run_ga(scenario, *, variant: str, additions: tuple, path: str, weights, safety: str, grid: float,
+            pop_size: int, max_gen: int, rng) -> tuple[list, list, dict]:
     """One EGA run: (per-robot polylines or None, per-robot PBs or None, info)."""
     from pymoo.optimize import minimize
 
     from htetro_opt.algorithms.enhanced_ga import EnhancedGA
     from htetro_opt.operators.path_bases import PathBasesSampling
 
-    finer = variant == "ega"
-    initial = _initial(scenario, grid=grid, pop_size=pop_size, finer=finer, rng=rng)
+    initial = _initial(scenario, grid=grid, pop_size=pop_size, finer="finer-apf" in additions, rng=rng)
     sub, rows = _reachable(scenario, initial)
     lines, pbs = [None] * scenario.n_robots, [None] * scenario.n_robots
     info = {"algorithm": variant, "weights": list(weights), "path": path, "safety": safety, "grid": grid,
@@ -74,7 +74,7 @@ def _run_ga(scenario, *, variant: str, path: str, weights, safety: str, grid: fl
         return lines, pbs, {**info, "history": [], "terms": None}
     problem = PathBasesProblem(sub, path=path, weights=weights, safety=safety, grid=grid)
     sampling = PathBasesSampling([initial[i] for i in rows])
-    algorithm = (EnhancedGA if variant == "ega" else EnhancedGA.as_published)(pop_size, sampling=sampling)
+    algorithm = EnhancedGA(pop_size, sampling=sampling, additions=additions)
     res = minimize(problem, algorithm, ("n_gen", max_gen + 1), seed=derive_seed(rng))
     best = _best(problem, [ind.X[0] for ind in res.algorithm.pop])
     for k, row in enumerate(rows):
@@ -93,9 +93,10 @@ def _check_common(scenario, path, safety, grid, pop_size, max_gen):
     return scenario, grid, pop_size, max_gen
 
 
-def _plan_weighted(scenario, *, variant, path, weights, normalise, safety, grid, pop_size, max_gen, seed):
+def _plan_weighted(scenario, *, variant, additions, path, weights, normalise, safety, grid, pop_size, max_gen, seed):
     began = time.perf_counter()
     scenario, grid, pop_size, max_gen = _check_common(scenario, path, safety, grid, pop_size, max_gen)
+    additions = SPEC.options["additions"].check(additions, "additions")
     normalise = check_bool(normalise, "normalise")
     if normalise and weights is not None:
         raise ParameterError("give weights or normalise=True, not both")
@@ -107,8 +108,9 @@ def _plan_weighted(scenario, *, variant, path, weights, normalise, safety, grid,
         optima, counts = [], []
         for term, name in enumerate(("length", "smoothness", "safety")):
             single = tuple(float(term == k) for k in range(3))
-            _, single_pbs, single_info = _run_ga(scenario, variant=variant, path=path, weights=single, safety=safety,
-                                                 grid=grid, pop_size=pop_size, max_gen=max_gen, rng=rng)
+            _, single_pbs, single_info = _run_ga(scenario, variant=variant, additions=additions, path=path,
+                                                 weights=single, safety=safety, grid=grid, pop_size=pop_size,
+                                                 max_gen=max_gen, rng=rng)
             terms = single_info["terms"]
             counts.append(sum(len(p) for p in single_pbs if p is not None))
             if terms is None:
@@ -124,11 +126,11 @@ def _plan_weighted(scenario, *, variant, path, weights, normalise, safety, grid,
                    best_length / best_safety_cost if np.isfinite(best_safety_cost) and best_safety_cost > 0 else 0.0)
         extra["normalised_from"] = {"length": best_length, "smoothness_deg": best_smoothness,
                                     "safety_cost": best_safety_cost, "path_bases": counts}
-    lines, pbs, info = _run_ga(scenario, variant=variant, path=path, weights=weights, safety=safety, grid=grid,
-                               pop_size=pop_size, max_gen=max_gen, rng=rng)
+    lines, pbs, info = _run_ga(scenario, variant=variant, additions=additions, path=path, weights=weights,
+                               safety=safety, grid=grid, pop_size=pop_size, max_gen=max_gen, rng=rng)
     history = info.pop("history")
     info.pop("terms")
-    info.update(extra, path_bases=[None if p is None else p.tolist() for p in pbs])
+    info.update(extra, path_bases=[None if p is None else p.tolist() for p in pbs], additions=list(additions))
     # a spline through the PBs may cut a corner in every member: reported as infeasible, not raised
     return finish_plan(scenario, lines, method=variant, began=began, history=history, info=info,
                        require_feasible=path == "linear")
@@ -136,10 +138,12 @@ def _plan_weighted(scenario, *, variant, path, weights, normalise, safety, grid,
 
 def plan_ega(scenario, *, path: str = _EGA["path"], weights=None, normalise: bool = _EGA["normalise"],
              safety: str = _EGA["safety"], grid: float = _EGA["grid"], pop_size: int = _EGA["pop_size"],
-             max_gen: int = _EGA["max_gen"], seed=_EGA["seed"]) -> ContinuousPlan:
-    """Every robot's path by Nazarahari et al. 2019's enhanced GA with our additions (deletion of
-    every child, taut refinement, a finer APF for half the initial paths; see
-    :class:`~htetro_opt.algorithms.EnhancedGA`), several robots planned jointly (§4.5).
+             max_gen: int = _EGA["max_gen"], seed=_EGA["seed"], additions=_EGA["additions"]) -> ContinuousPlan:
+    """Every robot's path by Nazarahari et al. 2019's enhanced GA with our additions (by default all of
+    :data:`~htetro_opt.algorithms.EGA_ADDITIONS`: deletion of every child, repeated deletion passes,
+    the straight segment first, duplicate children dropped, taut refinement, a finer APF for half the
+    initial paths; see :class:`~htetro_opt.algorithms.EnhancedGA`), several robots planned jointly
+    (§4.5).
 
     Parameters
     ----------
@@ -162,11 +166,15 @@ def plan_ega(scenario, *, path: str = _EGA["path"], weights=None, normalise: boo
     pop_size, max_gen : int, keyword-only
         PS and IS (10 and 20, as in Table 2).
     seed : None, int or numpy Generator, keyword-only
+    additions : collection of str, keyword-only
+        Our additions switched on, exactly (names of :data:`~htetro_opt.algorithms.EGA_ADDITIONS`,
+        or ``"all"``, ``"none"``, ``"a,b"``); the plan's ``additions`` lists them.
 
     Returns
     -------
     ContinuousPlan
-        ``history``: the best cost per generation (the initial population first); ``info``:
+        ``history``: the best cost per generation (the initial population first); ``additions``: the
+        additions it ran with; ``info``:
         ``algorithm, weights, path, safety, grid, pop_size, max_gen, path_bases`` (per robot), and
         ``normalised_from`` with ``normalise``: ``length``, ``smoothness_deg``, ``safety_cost`` (the
         single-term optima L*, S*, c_R*) and ``path_bases`` (the PBs of the three runs' best
@@ -177,27 +185,39 @@ def plan_ega(scenario, *, path: str = _EGA["path"], weights=None, normalise: boo
     Raises
     ------
     ParameterError
-        On a bad option (see :class:`~htetro_opt.problems.PathBasesProblem`), or both ``weights`` and
-        ``normalise``.
+        On a bad option (see :class:`~htetro_opt.problems.PathBasesProblem`), an unknown addition, or
+        both ``weights`` and ``normalise``.
 
     Examples
     --------
     >>> from htetro_opt.scenarios import load_scenario
     >>> plan = plan_ega(load_scenario("ega07_slits1"), seed=1)
-    >>> plan.reached, round(plan.length, 2)  # the exact optimum is 64.43
-    (True, 64.43)
+    >>> plan.reached, round(plan.length, 2), len(plan.additions)  # the exact optimum is 64.43
+    (True, 64.43, 6)
     """
-    return _plan_weighted(scenario, variant="ega", path=path, weights=weights, normalise=normalise, safety=safety,
-                          grid=grid, pop_size=pop_size, max_gen=max_gen, seed=seed)
+    return _plan_weighted(scenario, variant="ega", additions=additions, path=path, weights=weights,
+                          normalise=normalise, safety=safety, grid=grid, pop_size=pop_size, max_gen=max_gen, seed=seed)
 
 
-def plan_ega_paper(scenario, *, path: str = _EGA["path"], weights=None, normalise: bool = _EGA["normalise"],
-                   safety: str = _EGA["safety"], grid: float = _EGA["grid"], pop_size: int = _EGA["pop_size"],
-                   max_gen: int = _EGA["max_gen"], seed=_EGA["seed"]) -> ContinuousPlan:
-    """:func:`plan_ega` with the EGA as published (:meth:`~htetro_opt.algorithms.EnhancedGA.as_published`):
-    deletion of one roulette pick per generation, no taut refinement, the APF at step d only."""
-    return _plan_weighted(scenario, variant="ega-paper", path=path, weights=weights, normalise=normalise,
-                          safety=safety, grid=grid, pop_size=pop_size, max_gen=max_gen, seed=seed)
+def plan_ega_paper(scenario, *, path: str = _PAPER["path"], weights=None, normalise: bool = _PAPER["normalise"],
+                   safety: str = _PAPER["safety"], grid: float = _PAPER["grid"], pop_size: int = _PAPER["pop_size"],
+                   max_gen: int = _PAPER["max_gen"], seed=_PAPER["seed"], additions=_PAPER["additions"]) -> ContinuousPlan:
+    """:func:`plan_ega` with the EGA as published (:meth:`~htetro_opt.algorithms.EnhancedGA.as_published`,
+    ``additions=()`` by default): the APF at step d only; each generation the deletion of one roulette
+    pick, its PBs assessed once each, left to right, as one more child; every child kept, copies too; no
+    taut refinement. ``path="spline"`` joins the PBs by a cubic spline (Fig. 5b); its objectives are
+    measured on the spline sampled into short segments (§4.4). ``additions`` switches ours on singly.
+
+    Examples
+    --------
+    >>> from htetro_opt.scenarios import load_scenario
+    >>> plan = plan_ega_paper(load_scenario("ega07_slits1"), seed=1)
+    >>> plan.reached, plan.additions
+    (True, ())
+    """
+    return _plan_weighted(scenario, variant="ega-paper", additions=additions, path=path, weights=weights,
+                          normalise=normalise, safety=safety, grid=grid, pop_size=pop_size, max_gen=max_gen,
+                          seed=seed)
 
 
 def plan_moea(scenario, *, algorithm: str = "nsga2", path: str = _MOEA["path"], safety: str = _MOEA["safety"],

@@ -13,6 +13,7 @@ from htetro_opt._spec import (
     Option,
     Problem,
     TaskSpec,
+    additions,
     at_most,
     bytes_text,
     choice,
@@ -22,9 +23,10 @@ from htetro_opt._spec import (
     seed_option,
 )
 from htetro_opt._validation import check_bool, check_time_limit
+from htetro_opt.algorithms.names import EGA_ADDITIONS  # plain data: the EGA's additions, named once
 from htetro_opt.errors import ParameterError, ScenarioError
 
-__all__ = ["SPEC", "PATH_KINDS", "SAFETY_KINDS", "RRT_TIME_LIMIT"]
+__all__ = ["SPEC", "EGA_ADDITIONS", "PATH_KINDS", "SAFETY_KINDS", "RRT_TIME_LIMIT"]
 
 PATH_KINDS = ("linear", "spline")
 """How a chromosome's path bases are joined: straight segments, or a cubic spline through them."""
@@ -79,6 +81,8 @@ OPTIONS = (
     Option("max_gen", at_most(integer(0), 100_000, lambda v: f"generations would take {duration_text(v * 1e-2)} or "
                               "more at ten milliseconds each"), "generations", default=20, type=int, metavar="N"),
     seed_option(),
+    Option("additions", additions(EGA_ADDITIONS), "the enhanced GA's additions of ours switched on: all, none, or "
+           f"some of {', '.join(EGA_ADDITIONS)} (docs/papers/nazarahari2019.md)", metavar="NAMES"),
     Option("n", integer(1, none=True), "the roadmap's samples", flag="",
            default_text="the paper's per map"),
     Option("radius", real(0.0, above=True, none=True),
@@ -94,9 +98,12 @@ METHODS = (
     Method("exact", "._exact:plan_exact", "the shortest path of each robot alone over the visibility graph of the "
            "free space's corners (the optimum for a point robot)", exact=True, origin="reference"),
     Method("ega", "._ega:plan_ega", "the enhanced GA over path bases with our additions, all robots jointly",
-           (*_GA, "weights", "normalise"), seeded=True, origin="ours", paper=_PAPER, family=("ga",)),
-    Method("ega-paper", "._ega:plan_ega_paper", "the same GA as published", (*_GA, "weights", "normalise"),
-           seeded=True, origin="paper", paper=_PAPER, family=("ga",)),
+           (*_GA, "weights", "normalise", "additions"), defaults={"additions": tuple(EGA_ADDITIONS)}, seeded=True,
+           origin="ours", paper=_PAPER, family=("ga",)),
+    # §4.3 as published: deletion of one roulette pick per generation in one sequential pass, every child kept,
+    # the APF at step d only
+    Method("ega-paper", "._ega:plan_ega_paper", "the same GA as published", (*_GA, "weights", "normalise", "additions"),
+           defaults={"additions": ()}, seeded=True, origin="paper", paper=_PAPER, family=("ga",), revision=2),
     Method("nsga2", "._ega:plan_nsga2", "pymoo's NSGA-II over the same path bases, minimising (length, smoothness, "
            "-safety); the front in the JSON", _GA, defaults={"safety": "min"}, seeded=True, origin="library",
            family=("ga",)),
