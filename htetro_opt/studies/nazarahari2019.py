@@ -1,18 +1,18 @@
 """Nazarahari et al. 2019's experiments beside the paper's figures: Table 2 (12 maps × A* 1, A* 0.25,
-PRM, B-RRT, PSO, EGA linear, EGA spline, and our EGA-paper, × seeds), §5.1's five (IS, PS) pairs,
-§5.3's normalised weights on map 4 (our EGA and the EGA as published), and the four robots of
-``ega_cross4`` (our Fig. 11), every length beside the exact optimum (the visibility graph: r = 0 on
-these maps). The report adds why A* 0.25 equals A* 1 on our maps and each A* path after the deletion
+PRM, B-RRT, PSO, the paper's EGA as published (``ega-paper``) with linear and spline paths beside the
+paper's "EGA linear" and "EGA spline" rows, and the project's ``ega`` with both path types beside them,
+× seeds), §5.1's five (IS, PS) pairs (``ega-paper``), §5.3's normalised weights on map 4 (the EGA as
+published and ours), and the four robots of ``ega_cross4`` (our Fig. 11; both EGAs), every length
+beside the exact optimum (the visibility graph: r = 0 on these maps). Every record lists the additions
+of ours its method ran with (``additions``: none for ``ega-paper``). The report adds why A* 0.25 equals A* 1 on our maps and each A* path after the deletion
 operator (an any-angle post-smoothing, not in the paper), and how far the PSO shortened its APF start.
 
 Not on the study runner: the runner's tasks plan grid scenarios, and each trial here needs its map's
-exact optimum, computed once per map (0.01–0.1 s) in this process and shared by every method and
-seed. The trials run on worker processes (``jobs``, default the local cores). A seed costs about
-90 s of trials on one core (EGA spline about 80 s of it, 0.5–15 s a map; every other Table 2 row
-0.01–1.5 s); §5.1's five pairs cost 45 s a seed, so by default they run on the first seed only
-(``pair_seeds``; ``--pair-seeds N``, ``--no-pairs``). The default run (5 seeds, pairs on one; what
-``htetro-opt study nazarahari2019`` runs) took 14 minutes on 2 cores under a load average of 5–9
-from other work (benchmarks/results/nazarahari2019).
+exact optimum, computed once per map (0.01–0.1 s) before the trials and shared by every method and
+seed. The trials run on a pool of worker processes (``jobs``, default the local cores; ``jobs=1``:
+one after the other in the calling process). A seed costs a few minutes of trials on one core (the
+spline EGAs most of it, 0.5–15 s a map each; every other Table 2 row 0.01–1.5 s); §5.1's five pairs
+cost about a minute a seed, so by default they run on the first seed only (``pair_seeds``).
 
 ``htetro-opt study nazarahari2019 [--seeds N] [--workers N] [--out DIR]`` runs it with the defaults
 (:func:`run_nazarahari2019` takes the rest: the maps, methods, pairs, B-RRT's time limit) and prints the
@@ -37,8 +37,8 @@ from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers.continuous import plan_continuous
 from htetro_opt.studies.runner import write_report as write_study_report
 
-__all__ = ["MAPS", "METHODS", "PAPER_TABLE2", "PAPER_PAIRS", "PAPER_TABLE3", "PAIRS", "run_nazarahari2019",
-           "report", "write_report"]
+__all__ = ["MAPS", "METHODS", "PAPER_TABLE2", "PAPER_PAIRS", "PAPER_TABLE3", "PAIRS", "PAIRS_METHOD", "NORMALISED",
+           "CROSS4", "run_nazarahari2019", "report", "write_report"]
 
 MAPS = ("ega01_random1", "ega02_maze1", "ega03_home", "ega04_corridor1", "ega05_boxpile", "ega06_corridor2",
         "ega07_slits1", "ega08_slits2", "ega09_maze2", "ega10_maze3", "ega11_random2", "ega12_plankpile")
@@ -50,12 +50,17 @@ METHODS = {
     "PRM": ("prm", {}),  # the paper's (n, radius) per map
     "B-RRT": ("rrt", {}),  # 120 s, the paper's terminal condition
     "PSO": ("pso", {}),
-    "EGA linear": ("ega", {}),
-    "EGA spline": ("ega", {"path": "spline"}),
-    "EGA-paper": ("ega-paper", {}),
+    "EGA linear": ("ega-paper", {}),
+    "EGA spline": ("ega-paper", {"path": "spline"}),
+    "ega linear (ours)": ("ega", {}),
+    "ega spline (ours)": ("ega", {"path": "spline"}),
 }
-"""Table 2's rows: label → (plan_continuous method, options). EGA-paper is ours: the paper's EGA as
-published, beside our EGA (with taut refinement and deletion of every child)."""
+"""Table 2's rows: label → (plan_continuous method, options). The paper's labels run the paper's
+algorithms (its EGA as published: ``ega-paper``) and stand beside its numbers; "(ours)" rows are the
+project's ``ega``, with every addition of ours (htetro_opt.algorithms.EGA_ADDITIONS), beside them."""
+
+PAIRS_METHOD = "ega-paper"
+"""The EGA §5.1's (IS, PS) pairs run with: the paper's, as published."""
 
 DETERMINISTIC = frozenset({"A* 1", "A* 0.25"})
 """Rows run once (the paper's A* has standard deviation 0)."""
@@ -178,8 +183,11 @@ PAPER_PAIRS = {"best_length_100_20": (33.80, 249.78, 124.74, 32.96, 45.40, 65.32
                "worst_ratio_20_10": {"linear": 1.026, "spline": 1.031}}
 """§5.1's figures: the (IS 100, PS 20) mean lengths per map, and (IS 20, PS 10)'s worst ratio to them."""
 
-NORMALISED = (("EGA linear", "ega"), ("EGA-paper", "ega-paper"))
+NORMALISED = (("EGA (ega-paper)", "ega-paper"), ("ega (ours)", "ega"))
 """The EGAs §5.3's normalisation runs with (label, plan_continuous method)."""
+
+CROSS4 = (("EGA (ega-paper)", "ega-paper"), ("ega (ours)", "ega"))
+"""The EGAs the four robots of ``ega_cross4`` are planned jointly with (label, plan_continuous method)."""
 
 PAPER_TABLE3 = {"weights": (1.000, 0.187, 0.201), "weighted_terms": (33.49, 32.40, 34.17),
                 "single_best": {"length": 32.71, "smoothness": 174.81, "safety": 154.76}}
@@ -201,7 +209,8 @@ class Run:
 
 def _record(plan, **keys) -> dict:
     return {**keys, "reached": bool(plan.reached and all(plan.feasible)), "length": float(plan.length),
-            "smoothness": float(np.nansum(plan.smoothness_deg)), "runtime": float(plan.runtime_s)}
+            "smoothness": float(np.nansum(plan.smoothness_deg)), "runtime": float(plan.runtime_s),
+            "additions": list(plan.additions)}
 
 
 def _trial(part: str, name: str, label: str, method: str, options: dict, seed, seeded: bool = True) -> dict:
@@ -224,7 +233,8 @@ def _trial(part: str, name: str, label: str, method: str, options: dict, seed, s
         w = plan.info["weights"]
         terms = (float(plan.lengths[0]), w[1] * float(plan.smoothness_deg[0]),
                  w[2] / max(float(plan.safety[0]), 1e-12))
-        return {"seed": seed, "method": label, "weights": list(w), "terms": list(terms),
+        return {"seed": seed, "method": label, "additions": list(plan.additions), "weights": list(w),
+                "terms": list(terms),
                 "single": plan.info["normalised_from"], "path_bases": len(plan.info["path_bases"][0]),
                 "safety": float(plan.safety[0]), "runtime": float(plan.runtime_s)}
     return {**_record(plan, map=name, method=label, seed=seed), "min_robot_distance": plan.min_robot_distance,
@@ -242,7 +252,7 @@ def run_nazarahari2019(seeds=5, *, maps=MAPS, methods=tuple(METHODS), pairs=PAIR
     maps, methods : keyword-only
         Subsets of :data:`MAPS` and :data:`METHODS`' labels.
     pairs : keyword-only
-        §5.1's (IS, PS) pairs to run with EGA linear (empty: skip).
+        §5.1's (IS, PS) pairs to run with the EGA as published, linear (:data:`PAIRS_METHOD`; empty: skip).
     pair_seeds : int, keyword-only
         How many of the seeds (the first) run the pairs: 1 by default, since the pairs cost a third
         of a seed's trials and the EGA's spread between seeds is small; ``None``: every seed.
@@ -251,7 +261,8 @@ def run_nazarahari2019(seeds=5, *, maps=MAPS, methods=tuple(METHODS), pairs=PAIR
     normalised, cross4 : bool, keyword-only
         Run §5.3's normalised weights (when map 4 is among ``maps``) and the four robots (default: both).
     jobs : int, keyword-only
-        Worker processes (default: the local cores; 1: this process). Every trial is a pure function
+        Worker processes of the pool (default: the local cores; 1: no pool, the trials one after the
+        other in the calling process). Every trial is a pure function
         of its map, method, options and seed, so the records are the same whatever ``jobs`` is, but
         for the runtimes.
     progress : callable, optional
@@ -274,14 +285,14 @@ def run_nazarahari2019(seeds=5, *, maps=MAPS, methods=tuple(METHODS), pairs=PAIR
                 tasks.append(("table2", name, label, method, options, seed, label not in DETERMINISTIC))
         for max_gen, pop_size in pairs:
             for seed in pair_seeds:
-                tasks.append(("pairs", name, f"({max_gen}, {pop_size})", "ega",
+                tasks.append(("pairs", name, f"({max_gen}, {pop_size})", PAIRS_METHOD,
                               {"pop_size": pop_size, "max_gen": max_gen}, seed))
     if normalised and "ega04_corridor1" in maps:
         tasks += [("normalised", "ega04_corridor1", label, method, {"normalise": True}, seed)
                   for label, method in NORMALISED for seed in seeds]
     if cross4:
         run.exact["ega_cross4"] = float(plan_continuous(load_scenario("ega_cross4")).length)
-        tasks += [("cross4", "ega_cross4", "EGA linear", "ega", {}, seed) for seed in seeds]
+        tasks += [("cross4", "ega_cross4", label, method, {}, seed) for label, method in CROSS4 for seed in seeds]
     records = [None] * len(tasks)
     if jobs == 1 or len(tasks) <= 1:
         for k, task in enumerate(tasks):
@@ -321,7 +332,9 @@ def report(run: Run) -> str:
     w(f"# Nazarahari et al. 2019, re-run ({len(run.seeds)} seeds; {run.seconds:.0f} s)\n\n")
     w("Lengths, smoothness (°, sum of turning angles) and runtimes (s) are mean ± std over the successful runs; "
       "success = reached and obstacle-free; gap = mean length / exact optimum − 1. Paper: Table 2 (50 runs, "
-      "their machine). Maps are our reconstructions (Fig. 6 is not in our copy).\n\n")
+      "their machine). Maps are our reconstructions (Fig. 6 is not in our copy). The paper's rows run the paper's "
+      "algorithms (EGA linear and EGA spline: `ega-paper`, the EGA as published) beside its numbers; the "
+      "\"(ours)\" rows run the project's `ega`, with every addition of ours.\n\n")
     w("## Table 2\n\n")
     summary = []
     for name in [m for m in MAPS if m in run.exact]:
@@ -353,7 +366,7 @@ def report(run: Run) -> str:
                 w(f"- {label}: mean gap {_signed(np.nanmean(gaps))} % (max {_signed(np.nanmax(gaps))} %), success "
                   f"{np.mean(succ):.0f} % over {len(gaps)} maps\n")
         astar = {n: length for (n, lab, length, _, _) in summary if lab == "A* 0.25"}
-        for label in ("EGA linear", "EGA-paper", "PSO"):
+        for label in ("EGA linear", "EGA spline", "ega linear (ours)", "ega spline (ours)", "PSO"):
             wins = [n for (n, lab, length, _, _) in summary if lab == label and n in astar and length < astar[n] - 1e-9]
             if any(lab == label for (_, lab, _, _, _) in summary):
                 w(f"- {label} shorter than A* 0.25 on {len(wins)} of {len(astar)} maps (paper, EGA: 7 of 12)\n")
@@ -367,7 +380,8 @@ def report(run: Run) -> str:
         w(_astar_note(run))
     if run.pairs:
         n = len({r["seed"] for r in run.pairs})
-        w(f"## §5.1: (IS, PS) pairs, EGA linear, {n} seed{'s' if n > 1 else ''} (mean length / the pair's best "
+        w(f"## §5.1: (IS, PS) pairs, EGA linear as published ({PAIRS_METHOD}), {n} seed{'s' if n > 1 else ''} "
+          "(mean length / the pair's best "
           "mean on the map; mean runtime)\n\n")
         labels = [f"({i}, {p})" for i, p in PAIRS]
         w("| map | " + " | ".join(labels) + " | paper (100, 20) |\n|---|" + "---|" * (len(labels) + 1) + "\n")
@@ -387,14 +401,17 @@ def report(run: Run) -> str:
         w(_normalised_section(run.normalised))
     if run.cross4:
         own = run.exact["ega_cross4"]
-        ok = [r for r in run.cross4 if r["reached"] and r["conflicts"] == 0]
         w("## Four robots (ega_cross4, our Fig. 11)\n\n")
-        w(f"- {len(ok)} of {len(run.cross4)} runs obstacle-free with every pair ≥ d_s = "
-          f"{run.cross4[0]['safety_distance']:.2f} apart; closest approach "
-          f"{_ms([r['min_robot_distance'] for r in run.cross4], 3)}\n")
-        w(f"- Σ lengths {_ms([r['length'] for r in run.cross4])} = "
-          f"{np.mean([r['length'] for r in run.cross4]) / own:.4f} × Σ own optima ({own:.2f}); runtime "
-          f"{_ms([r['runtime'] for r in run.cross4], 3)} s\n")
+        for label, _ in CROSS4:
+            rows = [r for r in run.cross4 if r.get("method") == label]
+            if not rows:
+                continue
+            ok = [r for r in rows if r["reached"] and r["conflicts"] == 0]
+            w(f"- {label}: {len(ok)} of {len(rows)} runs obstacle-free with every pair ≥ d_s = "
+              f"{rows[0]['safety_distance']:.2f} apart; closest approach "
+              f"{_ms([r['min_robot_distance'] for r in rows], 3)}; Σ lengths {_ms([r['length'] for r in rows])} = "
+              f"{np.mean([r['length'] for r in rows]) / own:.4f} × Σ own optima ({own:.2f}); runtime "
+              f"{_ms([r['runtime'] for r in rows], 3)} s\n")
     return out.getvalue()
 
 
@@ -441,7 +458,7 @@ def _normalised_section(records: list) -> str:
     w("| EGA | runs | W_S | W_R | L | W_S·S | W_R/R | largest / smallest (target ≤ 1.5) | L* | S* | R* | "
       "PBs: length-only, safety-only, weighted | R / R* |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
     for label, _ in NORMALISED:
-        rows = [r for r in records if r.get("method", "EGA linear") == label]
+        rows = [r for r in records if r.get("method") == label]
         if not rows:
             continue
         weights = np.array([r["weights"] for r in rows])
@@ -471,6 +488,6 @@ def write_report(folder, run: Run) -> tuple[Path, Path]:
     atomically (the folder must exist)."""
     rows = [{"part": part, "map": r["map"], "method": r.get("method", r.get("pair")), "seed": r["seed"],
              "reached": r["reached"], "length": round(r["length"], 6), "smoothness": round(r["smoothness"], 4),
-             "runtime": round(r["runtime"], 4)}
+             "runtime": round(r["runtime"], 4), "additions": ",".join(r.get("additions", ()))}
             for part, records in (("table2", run.table2), ("pairs", run.pairs)) for r in records]
     return write_study_report(folder, "nazarahari2019", report(run), rows)
