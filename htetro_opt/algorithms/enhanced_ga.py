@@ -34,7 +34,9 @@ switched singly by ``additions``:
   optimum on mazes, short of the wall corners (refining every child found nothing more on the twelve
   maps, in up to twice the time);
 - ``finer-apf``: half the initial population from the APF's lattice at step d / 2: the d = 1
-  lattice misses gaps narrower than 1, and with them the shortest way through ``ega12_plankpile``.
+  lattice misses gaps narrower than 1, and with them the shortest way through ``ega12_plankpile``;
+- ``apf-refinement``: a lattice that does not join a robot's start to its goal is halved up to three
+  times (the paper's APF at d finds no path then: as published the robot is not reached).
 
 :func:`make_path_algorithm` gives pymoo's NSGA-II, NSGA-III, SMS-EMOA or AGE-MOEA with the same
 sampling, crossover, mutation and duplicate elimination, deletion as their repair (the command
@@ -105,7 +107,8 @@ class EnhancedGA(GeneticAlgorithm):
         β of the roulette's P ∝ exp(−β c / c_worst) (8).
     additions : collection of str
         Our additions switched on (names of :data:`~htetro_opt.algorithms.EGA_ADDITIONS`;
-        default all; ``()``: the paper's EGA). ``finer-apf`` acts only when ``sampling`` is not given
+        default all; ``()``: the paper's EGA). ``finer-apf`` and ``apf-refinement`` act only when
+        ``sampling`` is not given
         (see :func:`~htetro_opt.operators.path_bases.initial_paths`).
     collision_tries : int
         Moves tried per conflicted child with several robots (§4.5; 20).
@@ -143,7 +146,8 @@ class EnhancedGA(GeneticAlgorithm):
         on = set(self.additions)
         super().__init__(
             pop_size=pop_size,
-            sampling=sampling if sampling is not None else PathBasesSampling(finer="finer-apf" in on),
+            sampling=sampling if sampling is not None else PathBasesSampling(finer="finer-apf" in on,
+                                                                             refine="apf-refinement" in on),
             crossover=crossover if crossover is not None else PathBasesCrossover(),
             mutation=mutation if mutation is not None else PathBasesMutation(),
             # the paper keeps every path, copies included (child-dedup off: pymoo's no-op elimination)

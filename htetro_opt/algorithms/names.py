@@ -56,6 +56,8 @@ EGA_ADDITIONS = {
                        "visibility-graph search over their own PBs and the wall corners within 2 d of them",
     "finer-apf": "half the initial paths come from the APF lattice at half the step, d / 2; the paper's APF runs "
                  "at d only",
+    "apf-refinement": "when the APF lattice does not join a robot's start to its goal it is halved up to three "
+                      "times (d / 2 ... d / 8); the paper's APF at d then finds no path, and the robot is not reached",
 }
 """Our additions to Nazarahari et al. 2019's enhanced GA (§4.3), by name (:class:`~htetro_opt.algorithms.EnhancedGA`):
 the continuous task's ``ega`` runs them all, ``ega-paper`` (the paper's) none; each is switched on or off singly by

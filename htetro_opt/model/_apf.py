@@ -113,7 +113,7 @@ def _walks(graph: csr_matrix, depth: np.ndarray, source: int, n_walks: int, rng:
 
 
 def apf_paths(geometry: ContinuousGeometry, start, goal, *, n_paths: int = 10, grid: float = 1.0,
-              seed=None) -> tuple[list[np.ndarray], dict]:
+              seed=None, refinements: int = REFINEMENTS) -> tuple[list[np.ndarray], dict]:
     """Up to ``n_paths`` distinct feasible paths from ``start`` to ``goal`` by the APF (see the module
     docstring), each as its PBs.
 
@@ -128,6 +128,8 @@ def apf_paths(geometry: ContinuousGeometry, start, goal, *, n_paths: int = 10, g
         d, the lattice spacing (halved up to three times when the start does not reach the goal).
     seed : None, int or numpy Generator, keyword-only
         Breaks the ties (None: fresh entropy).
+    refinements : int, keyword-only
+        How many times the lattice may be halved (:data:`REFINEMENTS`; 0: the paper's lattice only).
 
     Returns
     -------
@@ -151,12 +153,13 @@ def apf_paths(geometry: ContinuousGeometry, start, goal, *, n_paths: int = 10, g
     (3, 16, True)
     """
     n_paths = check_int(n_paths, "n_paths", minimum=1)
+    refinements = check_int(refinements, "refinements", minimum=0)
     grid = check_grid(grid, geometry)
     rng = as_rng(seed)
     start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
     if np.array_equal(start, goal):
         return [np.empty((0, 2))], {"grid": grid, "depth": 0, "nodes": 0}
-    for refinement in range(REFINEMENTS + 1):
+    for refinement in range(refinements + 1):
         d = grid / 2 ** refinement
         nodes, graph = lattice_graph(geometry, d, ends=[start, goal])
         source, target = len(nodes) - 2, len(nodes) - 1
@@ -181,11 +184,12 @@ def apf_paths(geometry: ContinuousGeometry, start, goal, *, n_paths: int = 10, g
 
 
 def apf_population(geometry: ContinuousGeometry, start, goal, n: int, *, grid: float = 1.0,
-                   seed=None) -> tuple[list[np.ndarray], dict]:
+                   seed=None, refinements: int = REFINEMENTS) -> tuple[list[np.ndarray], dict]:
     """Exactly ``n`` initial paths (as PBs): the APF's distinct paths (:func:`apf_paths`), filled up
     as §4.2 says with copies of random ones whose PBs each move, with probability :data:`FILL_RATE`,
     to a uniform point of the disc of radius d/2 around them, a copy kept only if it is feasible and
     new. After ``10 n`` tries the rest are plain copies (a path without PBs has no other form).
+    ``refinements`` as in :func:`apf_paths`.
 
     Returns
     -------
@@ -203,7 +207,7 @@ def apf_population(geometry: ContinuousGeometry, start, goal, n: int, *, grid: f
     """
     n = check_int(n, "n", minimum=1)
     rng = as_rng(seed)
-    paths, info = apf_paths(geometry, start, goal, n_paths=n, grid=grid, seed=rng)
+    paths, info = apf_paths(geometry, start, goal, n_paths=n, grid=grid, seed=rng, refinements=refinements)
     info["distinct"] = len(paths)
     if not paths or len(paths) == n:
         return paths, info

@@ -11,17 +11,22 @@ from htetro_opt.errors import PlanningError
 __all__ = ["PathBasesSampling", "initial_paths"]
 
 
-def initial_paths(geometry, start, goal, n: int, *, grid: float, finer: bool, seed) -> list[np.ndarray]:
+def initial_paths(geometry, start, goal, n: int, *, grid: float, finer: bool, seed,
+                  refine: bool = True) -> list[np.ndarray]:
     """``n`` APF paths of one robot: all on the lattice of spacing ``grid`` (the paper), or, with
     ``finer`` (ours), the even-numbered ones there and the odd-numbered ones on the lattice of
     spacing ``grid`` / 2, which passes gaps narrower than ``grid`` (the paper's d = 1 lattice misses
-    the shortest way between ``ega12_plankpile``'s planks). Empty when the goal is unreachable."""
-    from htetro_opt.model._apf import apf_population  # shapely loads when paths are drawn, not with the operators
+    the shortest way between ``ega12_plankpile``'s planks). With ``refine`` (ours) a lattice that does
+    not join the start to the goal is halved up to three times; without it (the paper) the goal is then
+    unreachable. Empty when the goal is unreachable."""
+    from htetro_opt.model._apf import REFINEMENTS, apf_population  # shapely loads when paths are drawn
 
-    coarse, _ = apf_population(geometry, start, goal, n - n // 2 if finer else n, grid=grid, seed=seed)
+    refinements = REFINEMENTS if refine else 0
+    coarse, _ = apf_population(geometry, start, goal, n - n // 2 if finer else n, grid=grid, seed=seed,
+                               refinements=refinements)
     if not finer or not coarse or n < 2:
         return coarse
-    fine, _ = apf_population(geometry, start, goal, n // 2, grid=grid / 2, seed=seed)
+    fine, _ = apf_population(geometry, start, goal, n // 2, grid=grid / 2, seed=seed, refinements=refinements)
     out = []
     for i in range(len(coarse)):
         out.append(coarse[i])
@@ -41,6 +46,9 @@ class PathBasesSampling(Sampling):
         instead of running the APF again; cycled when fewer than the population.
     finer : bool
         Half the paths from the lattice of half the step (ours; see :func:`initial_paths`).
+    refine : bool
+        A lattice that does not join the start to the goal halved up to three times (ours; see
+        :func:`initial_paths`).
 
     Raises
     ------
@@ -48,10 +56,11 @@ class PathBasesSampling(Sampling):
         (In ``do``) when a robot's goal cannot be reached from its start.
     """
 
-    def __init__(self, initial=None, *, finer: bool = False) -> None:
+    def __init__(self, initial=None, *, finer: bool = False, refine: bool = True) -> None:
         super().__init__()
         self.initial = None if initial is None else [list(paths) for paths in initial]
         self.finer = check_bool(finer, "finer")
+        self.refine = check_bool(refine, "refine")
 
     def _do(self, problem, n_samples, *args, random_state=None, **kwargs):
         pools = []
@@ -60,7 +69,7 @@ class PathBasesSampling(Sampling):
                 pool = self.initial[k]
             else:
                 pool = initial_paths(problem.geometry, problem.starts[k], problem.goals[k], n_samples,
-                                     grid=problem.step, finer=self.finer, seed=random_state)
+                                     grid=problem.step, finer=self.finer, seed=random_state, refine=self.refine)
             if not pool:
                 raise PlanningError(f"robot {k} cannot reach its goal {problem.goals[k].tolist()} from its start "
                                     f"{problem.starts[k].tolist()}")

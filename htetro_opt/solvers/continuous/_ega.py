@@ -29,11 +29,11 @@ MOEA_ALGORITHMS = ("nsga2", "nsga3", "smsemoa", "agemoea")
 """pymoo's algorithms :func:`plan_moea` runs over path bases."""
 
 
-def _initial(scenario, *, grid: float, pop_size: int, finer: bool, rng) -> list:
+def _initial(scenario, *, grid: float, pop_size: int, finer: bool, rng, refine: bool = True) -> list:
     """Each robot's APF paths (an empty list for a robot whose goal is unreachable)."""
     from htetro_opt.operators.path_bases.sampling import initial_paths
 
-    return [initial_paths(scenario.geometry, s, g, pop_size, grid=grid, finer=finer, seed=rng)
+    return [initial_paths(scenario.geometry, s, g, pop_size, grid=grid, finer=finer, seed=rng, refine=refine)
             for s, g in zip(scenario.starts, scenario.goals)]
 
 
@@ -65,7 +65,8 @@ def _run_ga(scenario, *, variant: str, additions: tuple, path: str, weights, saf
     from htetro_opt.algorithms.enhanced_ga import EnhancedGA
     from htetro_opt.operators.path_bases import PathBasesSampling
 
-    initial = _initial(scenario, grid=grid, pop_size=pop_size, finer="finer-apf" in additions, rng=rng)
+    initial = _initial(scenario, grid=grid, pop_size=pop_size, finer="finer-apf" in additions, rng=rng,
+                       refine="apf-refinement" in additions)
     sub, rows = _reachable(scenario, initial)
     lines, pbs = [None] * scenario.n_robots, [None] * scenario.n_robots
     info = {"algorithm": variant, "weights": list(weights), "path": path, "safety": safety, "grid": grid,
@@ -142,7 +143,7 @@ def plan_ega(scenario, *, path: str = _EGA["path"], weights=None, normalise: boo
     """Every robot's path by Nazarahari et al. 2019's enhanced GA with our additions (by default all of
     :data:`~htetro_opt.algorithms.EGA_ADDITIONS`: deletion of every child, repeated deletion passes,
     the straight segment first, duplicate children dropped, taut refinement, a finer APF for half the
-    initial paths; see :class:`~htetro_opt.algorithms.EnhancedGA`), several robots planned jointly
+    initial paths, the APF's lattice refined where it does not connect; see :class:`~htetro_opt.algorithms.EnhancedGA`), several robots planned jointly
     (§4.5).
 
     Parameters
@@ -178,7 +179,8 @@ def plan_ega(scenario, *, path: str = _EGA["path"], weights=None, normalise: boo
         ``algorithm, weights, path, safety, grid, pop_size, max_gen, path_bases`` (per robot), and
         ``normalised_from`` with ``normalise``: ``length``, ``smoothness_deg``, ``safety_cost`` (the
         single-term optima L*, S*, c_R*) and ``path_bases`` (the PBs of the three runs' best
-        paths). A robot whose goal the APF cannot reach (even at d/8) is not reached. With
+        paths). A robot whose goal the APF cannot reach (at d; with ``apf-refinement`` even at d/8)
+        is not reached. With
         ``path="spline"`` a path may come out infeasible (every member's spline cutting a corner):
         ``feasible`` says so.
 

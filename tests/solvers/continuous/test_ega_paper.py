@@ -1,6 +1,6 @@
 """``ega-paper`` is Nazarahari et al. 2019's EGA and nothing of ours (issue 24): spies prove that it never
 calls the duplicate filter, the taut refinement, the repeated deletion passes, the straight start-goal
-segment or the finer APF, that its deletion assesses each PB once, left to right, on one roulette pick a
+segment, the finer APF or a refined APF lattice, that its deletion assesses each PB once, left to right, on one roulette pick a
 generation; each of our additions switched on alone runs (and only it); the plans list what ran."""
 
 import json
@@ -17,6 +17,7 @@ from htetro_opt.model.continuous import ContinuousGeometry
 from htetro_opt.operators.path_bases import (PathBasesDeletion, PathBasesDuplicateElimination, TautRefinement,
                                              delete_path_bases)
 from htetro_opt.scenarios import load_scenario
+from htetro_opt.scenarios.loader import parse_scenario
 from htetro_opt.solvers.continuous import plan_continuous
 
 MAP, GENERATIONS = "ega08_slits2", 4
@@ -72,6 +73,7 @@ def test_ega_paper_runs_none_of_our_additions(spies):
     assert all(c["passes"] is False and c["straight"] is False for c in spies["delete"].calls)
     assert len(spies["one_pass"].calls) == GENERATIONS
     assert {c["grid"] for c in spies["apf"].calls} == {1.0}  # the APF at step d only
+    assert {c["refinements"] for c in spies["apf"].calls} == {0}  # and never a finer lattice to rescue it
 
 
 @pytest.mark.parametrize("path", ["linear", "spline"])
@@ -103,6 +105,7 @@ ACTS = {  # addition -> whether its spies saw it act
     "child-dedup": lambda s: bool(s["dedup"].calls),
     "taut-refinement": lambda s: bool(s["taut"].calls),
     "finer-apf": lambda s: 0.5 in {c["grid"] for c in s["apf"].calls},
+    "apf-refinement": lambda s: {c["refinements"] for c in s["apf"].calls} == {3},
 }
 
 
@@ -112,6 +115,20 @@ def test_each_addition_alone_runs_and_only_it(spies, addition):
     plan = _plan("ega-paper", additions=[addition])
     assert plan.reached and plan.additions == (addition,) and plan.as_dict()["additions"] == [addition]
     assert {name for name, acts in ACTS.items() if acts(spies)} == {addition}
+
+
+def test_where_the_papers_apf_finds_no_path_the_plan_says_so_unless_refined():
+    # a corridor 0.6 wide between y = 1.2 and 1.8: no node of the d = 1 lattice is free
+    narrow = parse_scenario({"name": "narrow_gap", "width": 10, "height": 4, "robot_radius": 0.0,
+                             "obstacles": [[0, 0, 10, 1.2], [0, 1.8, 10, 4]],
+                             "robots": [{"start": [1, 1.5], "goal": [9, 1.5]}]})
+    paper = plan_continuous(narrow, method="ega-paper", max_gen=2)
+    assert not paper.success and not paper.reached and "did not reach" in paper.message
+    assert paper.as_dict()["additions"] == []
+    for method, options in (("ega-paper", {"additions": ["apf-refinement"]}), ("ega", {})):
+        plan = plan_continuous(narrow, method=method, max_gen=2, **options)
+        assert plan.success and narrow.geometry.path_feasible(plan.paths[0])
+        assert plan.length >= plan_continuous(narrow).length - 1e-9  # never below the exact optimum
 
 
 def test_an_unknown_addition_is_refused_by_name():
