@@ -19,8 +19,9 @@ run side by side, answers asserted equal.
 5. ega_cross4 x ``--seeds`` seeds, the four robots planned jointly by the EGA: every run's closest
    approach >= d_s, obstacle-free, sum of lengths <= 1.10 x the sum of the robots' own optima.
 
-6. Our additions to the EGA switched off one at a time (``EnhancedGA(10, refine=False)`` etc.), mean
-   length / exact over ``--ablation-seeds`` seeds per map.
+6. Our additions to the EGA switched off one at a time (``EnhancedGA(10, additions=...)`` without one of
+   ``EGA_ADDITIONS``), mean length / exact over ``--ablation-seeds`` seeds per map (the study
+   ``nazarahari2019_ablation`` switches them on one at a time instead).
 
 Run:  python benchmarks/bench_continuous.py [--repeat N] [--seeds S] [--ablation-seeds S] [--only 1,2,3,4,5,6]
 """
@@ -240,12 +241,12 @@ def bench_cross4(seeds):
 def bench_ablation(seeds):
     from pymoo.optimize import minimize
 
-    from htetro_opt.algorithms import EnhancedGA
+    from htetro_opt.algorithms import EGA_ADDITIONS, EnhancedGA
     from htetro_opt.problems import PathBasesProblem
 
     print(f"## 6. EGA / exact with one addition off, {seeds} seeds per map\n")
-    variants = {"all on": {}, "no refine": {"refine": False}, "no finer APF": {"finer_apf": False},
-                "no child deletion": {"delete_children": False}}
+    variants = {"all on": {}, **{f"no {name}": {"additions": [a for a in EGA_ADDITIONS if a != name]}
+                                 for name in ("taut-refinement", "finer-apf", "delete-every-child")}}
     print("| map | " + " | ".join(variants) + " |")
     print("|---|" + "---:|" * len(variants))
     for name in [n for n in list_scenarios() if n.startswith("ega") and n != "ega_cross4"]:
