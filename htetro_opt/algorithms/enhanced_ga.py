@@ -108,8 +108,7 @@ class EnhancedGA(GeneticAlgorithm):
     additions : collection of str
         Our additions switched on (names of :data:`~htetro_opt.algorithms.EGA_ADDITIONS`;
         default all; ``()``: the paper's EGA). ``finer-apf`` and ``apf-refinement`` act only when
-        ``sampling`` is not given
-        (see :func:`~htetro_opt.operators.path_bases.initial_paths`).
+        ``sampling`` is not given (see :func:`~htetro_opt.operators.path_bases.initial_paths`).
     collision_tries : int
         Moves tried per conflicted child with several robots (§4.5; 20).
 

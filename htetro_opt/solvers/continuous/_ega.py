@@ -157,9 +157,9 @@ def plan_ega(scenario, *, path: str = _EGA["path"], weights=None, normalise: boo
         W = (1, L*/S*, L*/c_R*) (a zero S* gives W_S = 0; a safety-only best path without clearance,
         c_R* = ∞, gives W_R = 0). Not with ``weights``. With ``safety="paper"`` the terms need not
         come out balanced: eq. 5's R grows with the number of PBs, and the safety-only run keeps
-        more of them than a run that also weighs length (measured on ``ega04_corridor1``, 5 seeds:
-        27.6 PBs against 8.0 on average, largest / smallest weighted term 3.26; as published 16.0
-        against 7.0, and 2.26; benchmarks/results/nazarahari2019).
+        more of them than a run that also weighs length (measured on ``ega04_corridor1``, 2 seeds:
+        27.5 PBs against 8.0 on average, largest / smallest weighted term 3.42; as published
+        (``ega-paper``) 14.5 against 7.0, and 2.19; benchmarks/results/nazarahari2019).
     safety : {"paper", "min"}, keyword-only
         Eq. 5's R over the PBs, or the smallest clearance along the path.
     grid : float, keyword-only
@@ -195,7 +195,7 @@ def plan_ega(scenario, *, path: str = _EGA["path"], weights=None, normalise: boo
     >>> from htetro_opt.scenarios import load_scenario
     >>> plan = plan_ega(load_scenario("ega07_slits1"), seed=1)
     >>> plan.reached, round(plan.length, 2), len(plan.additions)  # the exact optimum is 64.43
-    (True, 64.43, 6)
+    (True, 64.43, 7)
     """
     return _plan_weighted(scenario, variant="ega", additions=additions, path=path, weights=weights,
                           normalise=normalise, safety=safety, grid=grid, pop_size=pop_size, max_gen=max_gen, seed=seed)
