@@ -53,7 +53,7 @@ def run(args) -> dict:
     options = given_options(args, spec, method, others={other: _SPECS[other]})
     check_outputs(args, ("plot", "plot"), ("gif", "animation"))
     shown = console(args)
-    if method.name == "heat" and args.plot:
+    if "heat" in method.family and args.plot:
         options["keep_fields"] = True  # the plot draws the legs' fields
     # a GA reports its generations out of max_gen
     total = options.get("max_gen", spec.default_of(method, "max_gen")) if method.takes("progress") else None

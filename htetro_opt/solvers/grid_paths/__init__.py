@@ -25,7 +25,7 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "plan_exact": "._exact", "EXACT_METHODS": "._exact",
     "plan_ga": "._ga",
     "plan_max_fitness_sum": "._fitness_sum",
-    "plan_heat": "._heat", "HEAT_ENGINES": "._spec", "BAND_SEEDS": "._spec",
+    "plan_heat": "._heat", "HEAT_ADDITIONS": "._spec", "HEAT_ENGINES": "._spec", "BAND_SEEDS": "._spec",
     "replan_heat": "._replan", "HeatRun": "._replan",
     "solve_heat_field": "._heat_field", "HeatField": "._heat_field", "HEAT_ELEMENTS": "._spec",
 })

@@ -26,7 +26,29 @@ from htetro_opt._validation import check_bool, check_int, check_time_limit
 from htetro_opt.algorithms import CONVERGENCE_MEASURES, GA_ADDITIONS, PICKS
 from htetro_opt.errors import ParameterError, PlanningError, ScenarioError
 
-__all__ = ["SPEC", "HEAT_ELEMENTS", "HEAT_ENGINES", "BAND_SEEDS", "GA_PATIENCE"]
+__all__ = ["SPEC", "HEAT_ADDITIONS", "HEAT_ELEMENTS", "HEAT_ENGINES", "BAND_SEEDS", "GA_PATIENCE", "TABLE6_WEIGHTS"]
+
+HEAT_ADDITIONS = {
+    "pinch-split": "the field's bilinear mesh gives a node where two free cells touch only at a corner one copy "
+                   "per element, so no heat leaks where no robot passes (the paper's mesh shares the node)",
+    "converge": "the reaching waves run until nothing improves (a shortest-path search: the leg's optimum under "
+                "the field's rule) instead of stopping when the goal enters the list (§V-B step 4)",
+    "surrogate-cost": "the search minimises a sum over commands, eq. 12 with the smoothness and safety terms "
+                      "divided by the length of the leg's time-only plan, in place of the paper's tentative cost "
+                      "(eqs. 9-12 of the tentative path, over its own length)",
+    "exact-pick": "each leg's plan is the best by the exact eqs. 9-12 among the searches for the asked weights "
+                  "and for Table 6's four weightings, so that a weighting's plan scores at least as well by its "
+                  "own cost as any other row's",
+    "relax-fallback": "a leg with no path that never goes down the field takes the unconstrained optimum "
+                      "(info relaxed) instead of failing",
+    "band": "on maps above 4 million poses the search is restricted to a band around the field's ascent line, "
+            "widened until a path is found (options band, band_seed)",
+}
+"""Our additions to Do et al. 2021's planner (§V), by name: ``heat`` runs them all, ``heat-paper`` (the
+paper's) none; each is switched on or off by the ``additions`` option (docs/papers/do2021.md)."""
+
+TABLE6_WEIGHTS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (1.0, 1.0, 1.0))
+"""Do et al. 2021's Table-6 weightings (w_t, w_sm, w_sf) of eq. 12: time, smoothness, safety, multi-objective."""
 
 HEAT_ELEMENTS = ("q1", "p0")
 """Elements :func:`~htetro_opt.solvers.grid_paths.solve_heat_field` knows: the bilinear quadrilateral
@@ -67,6 +89,17 @@ def _heat_weights(value, name):
     return check_heat_weights(value, name)
 
 
+_ANY_ADDITION = additions({**GA_ADDITIONS, **HEAT_ADDITIONS})
+
+
+def _additions(value, name):
+    """Names of either planner's additions, ``"all"`` kept as such: the method's own set is known only in
+    :func:`_relations`, which resolves it."""
+    if isinstance(value, str) and value == "all":
+        return "all"
+    return _ANY_ADDITION(value, name)
+
+
 def _band(value, name):
     if value in ("auto", "full"):
         return value
@@ -104,8 +137,9 @@ OPTIONS = (
            default_text="per leg, the least multiple of 100 whose time is at least 1.5 times the leg's exact "
            "minimum time, as the paper's 100 and 200 on its maps"),
     seed_option(),
-    Option("additions", additions(GA_ADDITIONS), "the hTetro-GA's additions of ours switched on: all, none, or some "
-           f"of {', '.join(GA_ADDITIONS)} (each is described in docs/papers/cheng2020.md)", metavar="NAMES"),
+    Option("additions", _additions, "the additions of ours switched on: all, none, or some of the hTetro-GA's "
+           f"{', '.join(GA_ADDITIONS)} (docs/papers/cheng2020.md) or of the heat planner's "
+           f"{', '.join(HEAT_ADDITIONS)} (docs/papers/do2021.md)", metavar="NAMES"),
     Option("replan_window", integer(0), "windowed exact re-planning (ours): each generation a window of up to W "
            "executed commands of the fastest and of --replan-members random goal-reaching members is replaced by "
            "the minimum-time path between its ends; 0 off", default=40, type=int, metavar="W"),
@@ -167,15 +201,32 @@ _GA_KIND = dict(seeded=True, family=("ga",), capabilities={"progress"}, problem=
 _OURS = {"additions": tuple(GA_ADDITIONS)}
 _OFF = {"additions": ()}  # the paper's: none of ours (their parameters keep their defaults, for a switch back on)
 _PARAMETERS = {"replanning": "replan_window", "reach-repair": "reach_patience", "polish": "polish_window"}
+_HEAT_PARAMETERS = {"band": "band", "converge": "engine"}  # a band radius; engine: the converged search's
+_HEAT = (*_SIMULATOR, "weights", "t_max", "additions", "keep_fields")
 
 
 def _relations(method: Method, given: dict, label) -> None:
-    """A window or patience given (and not 0) sets an addition: refused when that addition is off."""
+    """``additions`` as the method's own names (``all``: every one of them, another planner's refused); a
+    window, patience or band given (and not 0) sets an addition: refused when that addition is off."""
     if not method.takes("additions"):
         return
+    heat = "heat" in method.family
+    own = HEAT_ADDITIONS if heat else GA_ADDITIONS
+    if "additions" in given:
+        names = given["additions"]
+        if names == "all":
+            names = tuple(own)
+        foreign = [n for n in names if n not in own]
+        if foreign:
+            raise ParameterError(f"{label('additions')}: {', '.join(foreign)} {'is' if len(foreign) == 1 else 'are'} "
+                                 f"not an addition of {method.name}: its additions are {', '.join(own)}")
+        given["additions"] = tuple(n for n in own if n in names)
     on = given.get("additions", method.defaults.get("additions", ()))
-    for addition, option in _PARAMETERS.items():
-        if given.get(option) and addition not in on:
+    for addition, option in (_HEAT_PARAMETERS if heat else _PARAMETERS).items():
+        value = given.get(option)
+        sets = option == "engine" and value is not None or option == "band" and isinstance(value, int) \
+            or option not in ("engine", "band") and bool(value)
+        if sets and addition not in on:
             raise ParameterError(f"{label(option)} sets the {addition} addition, which is off in {method.name}: "
                                  f"switch it on with {label('additions')} (e.g. {addition})")
 
@@ -203,10 +254,14 @@ METHODS = (
     _pymoo("nsga3", "NSGA-III"),
     _pymoo("smsemoa", "SMS-EMOA"),
     _pymoo("agemoea", "AGE-MOEA"),
-    Method("heat", "._heat:plan_heat", "Do et al. 2021's search up a heat-conduction field (diagonals included, "
-           "static maps)", (*_SIMULATOR, "weights", "t_max", "element", "monotone", "band", "band_seed", "engine",
-                            "field_options", "keep_fields", "sensor_range"),
-           origin="ours", paper="Do et al. 2021", family=("heat",), problem={"diagonals": True}),
+    Method("heat", "._heat:plan_heat", "Do et al. 2021's search up a heat-conduction field with our additions "
+           "(diagonals included, static maps)", (*_HEAT, "element", "monotone", "band", "band_seed", "engine",
+                                                 "field_options", "sensor_range"),
+           defaults={"additions": tuple(HEAT_ADDITIONS)}, presets={"method": "heat"}, origin="ours",
+           paper="Do et al. 2021", family=("heat",), problem={"diagonals": True}, revision=2),
+    Method("heat-paper", "._heat:plan_heat", "the same planner as published: the paper's mesh, reaching rule, stop "
+           "rule and tentative cost", _HEAT, defaults={"additions": ()}, presets={"method": "heat-paper"},
+           origin="paper", paper="Do et al. 2021", family=("heat",), problem={"diagonals": True}),
 )
 
 

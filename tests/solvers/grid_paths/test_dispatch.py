@@ -13,7 +13,8 @@ START, MID, GOAL = Pose(1, 1, "O", 0), Pose(3, 1, "O", 0), Pose(3, 3, "O", 0)
 
 def test_method_names():
     assert set(EXACT_METHODS) < set(SPEC.methods)
-    assert tuple(SPEC.methods)[2:] == ("htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea", "heat")
+    assert tuple(SPEC.methods)[2:] == ("htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea", "heat",
+                                     "heat-paper")
 
 
 @pytest.mark.parametrize("method", EXACT_METHODS)

@@ -11,7 +11,7 @@ from htetro_opt.model import Pose, Simulator, Workspace
 from htetro_opt.model.commands import COMMANDS, command_set
 from htetro_opt.problems.heat_costs import heat_fitness
 from htetro_opt.scenarios import load_scenario
-from htetro_opt.solvers.grid_paths import plan_exact, plan_heat, plan_path, solve_heat_field
+from htetro_opt.solvers.grid_paths import HEAT_ADDITIONS, plan_exact, plan_heat, plan_path, solve_heat_field
 
 MAPS = ("random", "h_shape", "three_slit", "maze")
 
@@ -184,10 +184,13 @@ def _clutter(seed, size=16):
     return Workspace(occ), [Pose(1, 1, "O", 0), Pose(size - 3, size - 3, "O", 0)]
 
 
+SURROGATE_ONLY = [a for a in HEAT_ADDITIONS if a != "exact-pick"]  # each row's own surrogate optimum, unpicked
+
+
 @pytest.mark.parametrize("name", ["random", "h_shape", "three_slit"])
-def test_each_weighting_minimises_its_own_cost_among_the_table6_plans(name):
+def test_each_weighting_minimises_its_own_surrogate_among_the_table6_plans(name):
     scenario = load_scenario(name)
-    plans = {w: plan_heat(scenario.workspace, scenario.roadmap, weights=w) for w in TABLE6}
+    plans = {w: plan_heat(scenario.workspace, scenario.roadmap, weights=w, additions=SURROGATE_ONLY) for w in TABLE6}
     length = len(plans[(1.0, 0.0, 0.0)].commands)  # L: the time-only constrained plan's length
     assert all(p.info["length"] == [length] for p in plans.values())
     assert all(p.reached and p.info["relaxed"] == [False] for p in plans.values())
