@@ -11,7 +11,7 @@ from htetro_opt.errors import ParameterError
 from htetro_opt.model import STATE_NAMES, Simulator, parse_commands
 from htetro_opt.problems import heat_fitness
 from htetro_opt.scenarios import load_scenario
-from htetro_opt.solvers.grid_paths import plan_exact, plan_heat
+from htetro_opt.solvers.grid_paths import HEAT_ADDITIONS, plan_exact, plan_heat
 from htetro_opt.studies import do2021
 from htetro_opt.studies.runner import (
     Study,
@@ -30,17 +30,25 @@ def _file(tmp_path, text, name="study.toml"):
     return path
 
 
-# A tiny do2021-shaped study: two maps, the four heat rows, the exact plan and a small GA, one seed.
+# A tiny do2021-shaped study: two maps, the four rows of both heat planners, the exact plan and both
+# GAs small, one seed.
 SMALL = """name = "do2021"
 task = "plan"
 scenarios = ["random", "h_shape"]
 seeds = 1
 metrics = ["objectives", "gap", "heat_fitness"]
-""" + "".join(f'[[methods]]\nlabel = "heat, {row}"\nmethod = "heat"\nweights = {list(w)}\n' for row, w in do2021.ROWS) + """
+""" + "".join(f'[[methods]]\nlabel = "{m}, {row}"\nmethod = "{m}"\nweights = {list(w)}\n'
+              for m in do2021.HEAT_METHODS for row, w in do2021.ROWS) + """
 [[methods]]
 label = "exact"
 method = "dijkstra"
 diagonals = true
+[[methods]]
+label = "htetro-ga-paper"
+method = "htetro-ga-paper"
+pop_size = 16
+max_gen = 40
+patience = 10
 [[methods]]
 label = "htetro-ga"
 method = "htetro-ga"
@@ -68,7 +76,7 @@ BAD = {
     "entry scenarios empty": ("scenarios = []\n", ["methods[0]", "scenarios", "non-empty"]),
     "override outside the entry's scenarios": ('scenarios = ["random"]\n[methods.per_scenario.three_slit]\nband = 4\n',
                                                ["per_scenario.three_slit", "not one of the entry's scenarios"]),
-    "front of heat": ('metrics = ["front"]\n', ["metric 'front'", "GA methods (", "heat planner"]),
+    "front of heat": ('metrics = ["front"]\n', ["metric 'front'", "GA methods (", "heat has no population"]),
 }
 
 
@@ -147,17 +155,20 @@ def test_bundled_study_is_the_builders():
     assert study == do2021.do2021_study()
     assert study.scenarios == do2021.TABLE6_SCENARIOS and study.seeds == tuple(range(5))
     trials = study.trials()
-    heat = [t for t in trials if t.method == "heat"]
-    assert len(heat) == 6 * 4 and all(t.seed is None for t in heat)
-    assert {tuple(t.parameters["weights"]) for t in heat} == {w for _, w in do2021.ROWS}
-    ga = [t for t in trials if t.method == "htetro-ga"]
-    assert sorted({t.scenario for t in ga}) == sorted(do2021.TABLE7_SCENARIOS)
-    assert {t.parameters["pop_size"] for t in ga} == {100} and len(ga) == 4 * 5
-    assert len(load_study("do2021").with_seeds(50).trials()) == 6 * 5 + 4 * 50
+    for method in ("heat-paper", "heat"):  # the paper's algorithm and ours, each under the four weightings
+        heat = [t for t in trials if t.method == method]
+        assert len(heat) == 6 * 4 and all(t.seed is None for t in heat)
+        assert {tuple(t.parameters["weights"]) for t in heat} == {w for _, w in do2021.ROWS}
+    for method in ("htetro-ga-paper", "htetro-ga"):  # Table 7: the paper's comparison (the GA as published) and ours
+        ga = [t for t in trials if t.method == method]
+        assert sorted({t.scenario for t in ga}) == sorted(do2021.TABLE7_SCENARIOS)
+        assert {t.parameters["pop_size"] for t in ga} == {100} and len(ga) == 4 * 5
+        assert {t.label for t in ga} == {method}
+    assert len(load_study("do2021").with_seeds(50).trials()) == 6 * (8 + 1) + 2 * 4 * 50
     only7 = do2021.do2021_study(2, tables=[7])
-    assert only7.scenarios == do2021.TABLE7_SCENARIOS and len(only7.trials()) == 4 * (5 + 2)
+    assert only7.scenarios == do2021.TABLE7_SCENARIOS and len(only7.trials()) == 4 * (8 + 1 + 2 * 2)
     only6 = do2021.do2021_study(tables="6")
-    assert {t.method for t in only6.trials()} == {"heat"}
+    assert {t.method for t in only6.trials()} == {"heat-paper", "heat"}
     for bad in ([8], [5], "6,x", []):
         with pytest.raises(ParameterError, match="(?i)tables"):
             do2021.do2021_study(tables=bad)
@@ -176,30 +187,41 @@ def test_smoke_run_reports_tables_6_and_7_beside_the_paper(small_run):
     md, table = do2021.write_report(folder, run)
     text = md.read_text(encoding="utf-8")
     for part in ("## Table 6", "### random", "### h_shape", "## Table 7", "**Targets.**",
-                 "0.879–0.894 / 0.867", "0.615", "0.945", "0.892", "0.869", "0.926", "0.914"):
+                 "0.879–0.894 / 0.867", "0.615", "0.945", "0.892", "0.869", "0.926", "0.914",
+                 "only the normalisation compares", "`htetro-ga-paper`, Cheng et al. 2020's GA as published"):
         assert part in text, part
+    assert "so f_t compares" not in text
+    # heat keeps Table 6's property on both maps (the exact pick); the report says so per planner
+    assert text.count("Table 6's property (each criterion's best value in its own row), heat: holds.") == 2
     assert "Table 8" not in text and "Fig. 13" not in text
     with open(table, newline="", encoding="utf-8") as handle:
         rows = list(csv.DictReader(handle))
     t6 = [r for r in rows if r["table"] == "6"]
-    assert [(r["scenario"], r["row"]) for r in t6] == [(s, row) for s in ("random", "h_shape")
-                                                        for row, _ in do2021.ROWS]
+    assert [(r["scenario"], r["method"], r["row"]) for r in t6] == [
+        (s, m, row) for s in ("random", "h_shape") for m in do2021.HEAT_METHODS for row, _ in do2021.ROWS]
     records = {(r["scenario"], r["label"]): r for r in run.records}
     for r in t6:  # our cells are the records', the paper's beside them
-        record = records[(r["scenario"], f"heat, {r['row']}")]
+        record = records[(r["scenario"], f"{r['method']}, {r['row']}")]
         assert float(r["f"]) == pytest.approx(record["heat_f"]) and float(r["gap"]) == pytest.approx(record["gap"])
         assert float(r["gap"]) >= -1e-12  # no heat plan beats the minimum time over its commands
-    cells = {(r["scenario"], r["row"]): r for r in t6}
-    assert cells[("random", "smoothness")]["paper_f_t"] == "0.879–0.894 / 0.867"
-    assert cells[("h_shape", "multi")]["paper_f_sf"] == "0.914"
+        assert r["additions"] == ("" if r["method"] == "heat-paper" else ",".join(HEAT_ADDITIONS))
+    cells = {(r["scenario"], r["method"], r["row"]): r for r in t6}
+    assert cells[("random", "heat-paper", "smoothness")]["paper_f_t"] == "0.879–0.894 / 0.867"
+    assert cells[("h_shape", "heat-paper", "multi")]["paper_f_sf"] == "0.914"
+    assert cells[("h_shape", "heat", "multi")]["paper_f_sf"] == ""  # the paper's numbers beside its algorithm only
     # Table 7: each row's heat f is the best of the heat plans under that row's weights
     t7 = [r for r in rows if r["table"] == "7"]
-    assert {r["label"] for r in t7} == {"heat", "htetro-ga", "exact"}
+    assert {r["label"] for r in t7} == {"heat-paper", "heat", "htetro-ga-paper", "htetro-ga", "exact"}
+    # every study record lists the additions switched on: none for the methods as published
+    assert all(r["additions"] == [] for r in run.records if r["method"] in ("heat-paper", "htetro-ga-paper"))
+    assert all(r["additions"] == list(HEAT_ADDITIONS) for r in run.records if r["method"] == "heat")
+    assert all(r["additions"] for r in run.records if r["method"] == "htetro-ga")
     for scenario in ("random", "h_shape"):
         for row, weights in do2021.ROWS:
-            heat = next(r for r in t7 if (r["scenario"], r["row"], r["label"]) == (scenario, row, "heat"))
-            record = records[(scenario, f"heat, {row}")]
-            assert float(heat["f"]) == pytest.approx(record["heat_f"])
+            for method in do2021.HEAT_METHODS:
+                heat = next(r for r in t7 if (r["scenario"], r["row"], r["label"]) == (scenario, row, method))
+                record = records[(scenario, f"{method}, {row}")]
+                assert float(heat["f"]) == pytest.approx(record["heat_f"])
             exact = records[(scenario, "exact")]
             scored = np.dot(weights, [exact["heat_f_t"], exact["heat_f_sm"], exact["heat_f_sf"]]) / sum(weights)
             assert float(next(r["f"] for r in t7 if (r["scenario"], r["row"], r["label"]) == (scenario, row, "exact"))) \
