@@ -72,6 +72,8 @@ __all__ = [
     "TABLE6_SCENARIOS",
     "TABLE7_SCENARIOS",
     "TABLES",
+    "ablation_report",
+    "ablation_rows",
     "report",
     "report_rows",
     "run_fig13",
@@ -768,3 +770,64 @@ def write_report(folder: str | os.PathLike, run: StudyRun | None = None, *, tabl
     table8 = None if table8 is None else list(table8)
     return write_study_report(folder, name, report(run, table8=table8, fig13=fig13),
                               report_rows(run, table8=table8, fig13=fig13))
+
+
+# --- the ablation study (do2021_ablation.toml) ------------------------------------------------------
+def ablation_rows(run: StudyRun) -> list[dict]:
+    """The ``do2021_ablation`` study's figures, one row per variant (a label's part before ", <row>"):
+    ``plans``; ``gap_mean`` / ``gap_max`` over its plans and ``time_gap_mean`` / ``time_gap_max``
+    over its time-row plans (fractions of the exact minimum time); ``f_<row>``, the mean over the maps
+    of that row's own f; ``property``, the maps where its four rows keep Table 6's property (each of
+    f_t, f_sm, f_sf and f at equal weights best in its own row), out of ``maps``; ``runtime_median``.
+
+    Raises
+    ------
+    ParameterError
+        As :func:`report`, or if a trial failed or a label does not end in a Table-6 row's name.
+    """
+    run = _check_run(run)
+    trials = [r for r in run.records if r.get("kind", "trial") == "trial"]
+    if any(not _ok(r) for r in trials):
+        raise ParameterError("the ablation table needs every trial: some failed (see the study's records)")
+    rows, names = [], dict(ROWS)
+    parts = {}
+    for r in trials:
+        variant, _, row = r["label"].rpartition(", ")
+        if row not in names:
+            raise ParameterError(f"label {r['label']!r} does not end in a Table-6 row ({', '.join(names)})")
+        parts.setdefault(variant, []).append((row, r))
+    for variant, mine in parts.items():
+        gaps = [r["gap"] for _, r in mine if r.get("gap") is not None]
+        timed = [r["gap"] for row, r in mine if row == "time" and r.get("gap") is not None]
+        maps = list(dict.fromkeys(r["scenario"] for _, r in mine))
+        held = 0
+        for scenario in maps:
+            cells = [{"row": row, **{k: r.get(f"heat_{k}") for k in _COSTS}} for row, r in mine
+                     if r["scenario"] == scenario]
+            held += not _property_breaks(cells) and len(cells) == len(ROWS)
+        rows.append({"variant": variant, "plans": len(mine), "reached": sum(bool(r.get("reached")) for _, r in mine),
+                     "gap_mean": float(np.mean(gaps)) if gaps else None, "gap_max": max(gaps, default=None),
+                     "time_gap_mean": float(np.mean(timed)) if timed else None, "time_gap_max": max(timed, default=None),
+                     **{f"f_{row}": _mean([r.get("heat_f") for name, r in mine if name == row]) for row, _ in ROWS},
+                     "property": held, "maps": len(maps),
+                     "runtime_median": float(np.median([r["runtime_s"] for _, r in mine]))})
+    return rows
+
+
+def _mean(values) -> float | None:
+    values = [v for v in values if v is not None]
+    return float(np.mean(values)) if values else None
+
+
+def ablation_report(run: StudyRun) -> str:
+    """:func:`ablation_rows` as the Markdown table of docs/papers/do2021.md."""
+    out = ["| variant | gap to exact, % (mean / max) | time row gap, % (mean / max) | "
+           + " | ".join(f"f {row} row" for row, _ in ROWS) + " | Table-6 property holds | s per plan (median) |",
+           "|---|" + "---:|" * (4 + len(ROWS))]
+    for r in ablation_rows(run):
+        def pair(mean, most):
+            return "–" if mean is None else f"{100 * mean:.1f} / {100 * most:.1f}"
+        out.append(f"| {r['variant']} | {pair(r['gap_mean'], r['gap_max'])} | {pair(r['time_gap_mean'], r['time_gap_max'])}"
+                   " | " + " | ".join(_fmt(r[f"f_{row}"]) for row, _ in ROWS)
+                   + f" | {r['property']} of {r['maps']} | {r['runtime_median']:.3f} |")
+    return "\n".join(out) + "\n"

@@ -296,3 +296,31 @@ def test_fig13_alone_is_reported_and_written(tmp_path):
         rows = list(csv.DictReader(handle))
     assert [r["table"] for r in rows] == ["13"] and "(5, 11)" in rows[0]["replans"]
     assert not hasattr(do2021, "main")  # one command line: htetro-opt study
+
+
+# --- the ablation study: the paper's algorithm, each addition alone, ours ------------------------------
+def test_the_ablation_study_runs_the_paper_each_addition_alone_and_ours():
+    from dataclasses import replace
+
+    study = load_study("do2021_ablation")
+    assert study.scenarios == do2021.TABLE6_SCENARIOS
+    variants = list(dict.fromkeys(t.label.rpartition(", ")[0] for t in study.trials()))
+    assert variants == ["paper (heat-paper)", *[f"paper + {a}" for a in HEAT_ADDITIONS], "ours (heat)"]
+    small = replace(study, scenarios=("random",))  # where the surrogate alone breaks Table 6's property
+    run = run_study(small, executor="serial")
+    assert run.failed == 0
+    for record in run.records:  # each variant's record lists exactly the additions it ran with
+        variant = record["label"].rpartition(", ")[0]
+        expected = {"paper (heat-paper)": [], "ours (heat)": list(HEAT_ADDITIONS)}.get(
+            variant, [variant.removeprefix("paper + ")])
+        assert record["additions"] == expected, record["label"]
+        assert record["reached"] and record["gap"] >= -1e-12  # none beats Dijkstra's minimum time
+    rows = {r["variant"]: r for r in do2021.ablation_rows(run)}
+    assert all(r["plans"] == 4 and r["maps"] == 1 for r in rows.values())
+    # the exact pick, alone or in ours, keeps Table 6's property on every map
+    assert rows["paper + exact-pick"]["property"] == rows["ours (heat)"]["property"] == 1
+    # random: heat-paper's multi row is below its time row's f at equal weights, the surrogate's smoothness
+    # row below its multi row's f_sm (the property broken)
+    assert rows["paper (heat-paper)"]["property"] == rows["paper + surrogate-cost"]["property"] == 0
+    text = do2021.ablation_report(run)
+    assert text.count("\n") == 2 + len(rows) and "| ours (heat) |" in text

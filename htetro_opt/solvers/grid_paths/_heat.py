@@ -612,7 +612,10 @@ def plan_heat(
     surrogate_cost, converge, pick = "surrogate-cost" in on, "converge" in on, "exact-pick" in on
     relax = "relax-fallback" in on
     leg_engine = engine if converge else "paper"
-    with_safety = w[2] > 0 or pick
+    # a converged time-only surrogate search is the fastest plan under the rule: no other row's plan can
+    # have a higher f = f_t, so the pick would only repeat it
+    exact_time = surrogate_cost and converge and w[1] == 0 and w[2] == 0
+    with_safety = w[2] > 0 or (pick and not exact_time)
     began = _time.perf_counter()
     if whole:
         if not compiled:
@@ -665,7 +668,7 @@ def plan_heat(
             there = temperature[space.cell_of[np.minimum(target, n - 1)]]  # dead targets: masked by the graph
             mask = ~moves[None, :] | (there >= here - field.epsilon)
         own = weighted(space, a, b, mask, w)
-        if not pick or own is None:
+        if not pick or own is None or exact_time:
             return own
         best, best_f = own, None
         for weights in (w, *[t for t in TABLE6_WEIGHTS if not _same_weights(t, w)]):
