@@ -9,9 +9,9 @@
   maximum of the GA's fitness sum f_gr + f_t + f_sm + f_sf under its own objective, the reference of
   its balanced pick.
 
-- ``"heat"`` (:func:`plan_heat`): Do et al. 2021's heat-conduction planner, a search that climbs
-  each leg's temperature field (:func:`solve_heat_field`, scikit-fem's bilinear element or
-  cell-centred), static maps only; :func:`replan_heat` runs it online on a scenario with hidden
+- ``"heat"``, ``"heat-paper"`` (:func:`plan_heat`): Do et al. 2021's heat-conduction planner (with our
+  additions, :data:`HEAT_ADDITIONS`, or as published), a search that climbs each leg's temperature
+  field (:func:`solve_heat_field`, scikit-fem's bilinear element or cell-centred), static maps only; :func:`replan_heat` runs it online on a scenario with hidden
   obstacles (§VI-A-7), sensing and replanning as the robot moves, and returns a :class:`HeatRun`.
 
 Every method returns a :class:`Plan`, re-validated in the simulator.

@@ -40,8 +40,8 @@ def plan_path(workspace: Workspace | Simulator, roadmap: Sequence[Pose], *,
         - ``"htetro-ga"``, ``"htetro-ga-paper"``, ``"nsga2"``, ``"nsga3"``, ``"smsemoa"``,
           ``"agemoea"``: a multi-objective GA over command chromosomes, leg by leg
           (:func:`~htetro_opt.solvers.grid_paths.plan_ga`);
-        - ``"heat"``: Do et al. 2021's heat-conduction planner, static maps only
-          (:func:`~htetro_opt.solvers.grid_paths.plan_heat`).
+        - ``"heat"``, ``"heat-paper"``: Do et al. 2021's heat-conduction planner with our additions,
+          or as published, static maps only (:func:`~htetro_opt.solvers.grid_paths.plan_heat`).
 
         Or a callable ``method(simulator, roadmap, **options)`` returning the plan's commands (tokens
         or global ids) from the roadmap's start; it gets a compiled
