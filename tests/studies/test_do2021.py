@@ -255,8 +255,10 @@ def test_table8_the_heat_planner_against_o_only_a_star_and_dijkstra(table8):
     assert astar["time"] > dijkstra["time"] > timed["time"]  # the 144.0 / 128.8 / 114.9
     assert timed["time_pct"] <= -15.0 and timed["shapes_used"] == "OI"
     assert multi["time"] < astar["time"]
-    assert multi["paper_time_pct"] == -18.03 and multi["paper_energy_pct"] == -15.69
-    assert timed["paper_time_pct"] is None
+    paper = rows["heat-paper, multi (1, 1, 1)"]  # the paper's algorithm, its numbers beside it
+    assert paper["reached"] and paper["time"] >= timed["time"] - 1e-9  # no faster than the minimum time
+    assert paper["paper_time_pct"] == -18.03 and paper["paper_energy_pct"] == -15.69
+    assert multi["paper_time_pct"] is None and timed["paper_time_pct"] is None
     scenario = load_scenario("indoor_room_doorway")
     assert timed["time"] == pytest.approx(plan_exact(scenario.workspace, scenario.roadmap, diagonals=True).time)
     text = do2021.report(table8=list(rows.values()))
