@@ -95,12 +95,13 @@ class HeatRun:
 
     def as_plan(self) -> Plan:
         """The run as a :class:`~htetro_opt.solvers.grid_paths.Plan` of its executed commands (method
-        ``"heat (replanning)"``), its ``info`` holding the run's fitness, weights, t_max, sensor range,
+        ``"heat (replanning)"``, or ``"heat-paper (replanning)"``), its ``info`` holding the additions, the run's fitness, weights, t_max, sensor range,
         plans and replans (and the last plan's fields, when kept)."""
-        info = {"fitness": dict(self.fitness), "weights": self.info["weights"], "t_max": self.info["t_max"],
+        info = {"additions": list(self.info.get("additions", ())), "fitness": dict(self.fitness),
+                "weights": self.info["weights"], "t_max": self.info["t_max"],
                 "sensor_range": self.info["sensor_range"], "plans": int(self.plans),
                 "replans": self.as_dict()["replans"], "fields": self.fields}
-        return Plan(method="heat (replanning)", commands=self.executed, reached=self.reached, time=self.time,
+        return Plan(method=f"{self.info.get('method', 'heat')} (replanning)", commands=self.executed, reached=self.reached, time=self.time,
                     poses=self.poses, leg_ends=(len(self.executed),) if self.reached else (),
                     failed_leg=-1 if self.reached else 0, runtime_s=self.runtime_s, info=info)
 
@@ -323,7 +324,8 @@ def replan_heat(scenario: Scenario, *, sensor_range: float = 6.0, **plan_options
     poses = replay.poses(0)
     weights, t_max = first_info["weights"], first_info["t_max"]
     fitness = heat_fitness(truth, poses, commands, t_max=t_max, timing=true_sim.timing, weights=weights)
-    info = {"sensor_range": sensor_range, "reach": reach, "t_max": t_max, "weights": list(weights),
+    info = {"method": plan_options.get("method", "heat"), "additions": list(first_info.get("additions", ())),
+            "sensor_range": sensor_range, "reach": reach, "t_max": t_max, "weights": list(weights),
             "revealed": int((known & ~scenario.workspace.occupancy).sum())}
     return HeatRun(executed=commands, poses=poses, time=float(replay.time[0]), reached=bool(replay.reached[0]),
                    replans=tuple(replans), fitness=fitness, plans=1 + len(replans),

@@ -260,7 +260,8 @@ METHODS = (
            defaults={"additions": tuple(HEAT_ADDITIONS)}, presets={"method": "heat"}, origin="ours",
            paper="Do et al. 2021", family=("heat",), problem={"diagonals": True}, revision=2),
     Method("heat-paper", "._heat:plan_heat", "the same planner as published: the paper's mesh, reaching rule, stop "
-           "rule and tentative cost", _HEAT, defaults={"additions": ()}, presets={"method": "heat-paper"},
+           "rule and tentative cost", (*_HEAT, "sensor_range"), defaults={"additions": ()},
+           presets={"method": "heat-paper"},
            origin="paper", paper="Do et al. 2021", family=("heat",), problem={"diagonals": True}),
 )
 
@@ -286,8 +287,9 @@ def _solve(spec: TaskSpec, problem: Problem, method, options: dict):
     from htetro_opt.solvers.grid_paths._replan import replan_heat
 
     # the options given only: replan_heat treats a given band apart (it hands plan_heat the map, not its simulator)
-    options = spec.check(method, options, stage="method", fill=False)
-    return replan_heat(problem.scenario, sensor_range=sensor_range, **options).as_plan()
+    chosen = method if isinstance(method, Method) else spec.method(method)
+    options = spec.check(chosen, options, stage="method", fill=False)
+    return replan_heat(problem.scenario, sensor_range=sensor_range, **chosen.presets, **options).as_plan()
 
 
 SPEC = TaskSpec(

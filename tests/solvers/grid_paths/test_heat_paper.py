@@ -190,3 +190,19 @@ def test_field_options_cannot_switch_the_pinch_split_behind_the_additions():
     ws = Workspace(np.zeros((6, 6), dtype=bool))
     with pytest.raises(ParameterError, match="pinch-split"):
         plan_heat(ws, [Pose(1, 1, "O", 0), Pose(3, 3, "O", 0)], field_options={"split_pinches": False})
+
+
+def test_heat_paper_replans_as_published_with_hidden_obstacles(capsys):
+    # Fig. 13 (§VI-A-7): the paper's planner, replanning as the sensors reveal the hidden cells
+    paper = _cli_json(capsys, ["plan", "maze_partial", "--method", "heat-paper", "--sensor-range", "6", "--json"])
+    ours = _cli_json(capsys, ["plan", "maze_partial", "--method", "heat", "--sensor-range", "6", "--json"])
+    assert paper["method"] == "heat-paper (replanning)" and paper["additions"] == [] and paper["success"]
+    assert ours["method"] == "heat (replanning)" and ours["additions"] == list(HEAT_ADDITIONS)
+    scenario = load_scenario("maze_partial")
+    truth = Simulator(scenario.true_workspace(), diagonals=True)
+    from htetro_opt.model import parse_commands
+
+    result = truth.run([parse_commands(",".join(paper["commands"]))], scenario.start)
+    assert result.valid[0] and result.final_pose(0) == scenario.goal  # valid in the true world, at the goal
+    optimum = plan_exact(scenario.true_workspace(), scenario.roadmap, diagonals=True).time
+    assert paper["time"] >= optimum - 1e-9 and paper["info"]["plans"] >= 2
