@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from htetro_opt._spec import Method
+from htetro_opt.algorithms import GA_ADDITIONS
 from htetro_opt.errors import ParameterError
 from htetro_opt.problems import SequencingInstance
 from htetro_opt.scenarios import load_scenario, load_tileset, tileset_path
@@ -236,13 +237,13 @@ def test_a_method_as_published_has_none_of_our_additions_and_ours_has_them_all()
             assert spec.default_of(method, "additions") == expected, (task, name)
 
 
-@pytest.mark.parametrize("addition", ["repair", "shortcut", "niching", "replanning", "reach-repair", "polish"])
+@pytest.mark.parametrize("addition", list(GA_ADDITIONS))
 def test_each_ga_addition_switches_on_alone_and_the_plan_says_so(grid, addition):
     options = {"pop_size": 6, "max_gen": 2, "max_length": 40}
     paper = plan_path(grid.workspace, grid.roadmap, method="htetro-ga-paper", **options)
     ours = plan_path(grid.workspace, grid.roadmap, method="htetro-ga", **options)
     alone = plan_path(grid.workspace, grid.roadmap, method="htetro-ga-paper", additions=[addition], **options)
-    assert paper.as_dict()["additions"] == [] and len(ours.as_dict()["additions"]) == 6
+    assert paper.as_dict()["additions"] == [] and ours.as_dict()["additions"] == list(GA_ADDITIONS)
     assert alone.as_dict()["additions"] == [addition]
     with pytest.raises(ParameterError, match="unknown addition 'speedup'"):
         plan_path(grid.workspace, grid.roadmap, method="htetro-ga", additions=["speedup"], **options)

@@ -138,8 +138,8 @@ def make_algorithm(
     Parameters
     ----------
     name : {"htetro-ga", "htetro-ga-paper", "nsga2", "nsga3", "smsemoa", "agemoea"}
-        ``"htetro-ga"`` is :class:`HTetroGA` with our repair, shortcut, niching, re-planning, reach repair
-        and balanced polish, ``"htetro-ga-paper"``
+        ``"htetro-ga"`` is :class:`HTetroGA` with our eight additions (:data:`GA_ADDITIONS`),
+        ``"htetro-ga-paper"``
         :meth:`HTetroGA.as_published`; the others are pymoo's algorithms with the command sampling,
         single-point crossover (rate ``crossover_rate``), mutation, duplicate elimination and the
         repair (NSGA-III with Das–Dennis reference directions, about ``pop_size`` of them).
@@ -153,8 +153,9 @@ def make_algorithm(
         algorithms take the same step through their mating (:class:`ReplanMating`), off by default
         (their defaults stay pymoo's); with a window and no ``replan_members``, K = 3.
     reach_share : float, optional
-        The hTetro-GA's cap on the goal-reaching section of its sort (:class:`HTetroGA`); None: the
-        default, 1 (no cap). pymoo's algorithms have no such sort: a share other than 1 is refused there.
+        The hTetro-GA's cap on the goal-reaching section of its sort (:class:`HTetroGA`, ours); None: the
+        default, 1 (no cap). ``"htetro-ga-paper"`` and pymoo's algorithms refuse a share other than 1
+        (the paper's sort has no such cap; pymoo's algorithms have no such sort).
     conservative : bool, optional
         pymoo's algorithms only: add the hTetro-GA's conservative offspring set (removal,
         rearrangement, shortcut) to their mating (:class:`ConservativeMating`); None: off (their
@@ -211,6 +212,10 @@ def make_algorithm(
         if name in ("htetro-ga", "htetro-ga-paper"):
             raise ParameterError(f"conservative applies to pymoo's algorithms (nsga2, nsga3, smsemoa, agemoea), not to "
                                  f"{name!r}, which always makes the conservative offspring set")
+    if name == "htetro-ga-paper" and replan.get("reach_share", 1.0) < 1.0:
+        raise ParameterError("reach_share caps the goal-reaching section of the sort, which the paper's sort does not "
+                             "(§IV-C: every member that reaches goes first): htetro-ga-paper refuses it, htetro-ga "
+                             "takes it")
     if additions is not None and name in ("htetro-ga", "htetro-ga-paper"):  # exactly these, whatever the name's
         return HTetroGA.with_additions(additions, pop_size, sampling=sampling, crossover_rate=crossover_rate,
                                        **replan)
@@ -228,7 +233,7 @@ def make_algorithm(
         raise ParameterError(f"reach_share applies to the hTetro-GA (htetro-ga, htetro-ga-paper), not to {name!r}")
     operators = dict(
         sampling=sampling,
-        crossover=CommandCrossover(prob=crossover_rate),
+        crossover=CommandCrossover(prob=crossover_rate, length_cap=2),  # the hTetro-GA's gene cap, as before
         mutation=CommandMutation(),
         eliminate_duplicates=CommandDuplicateElimination(),
         repair=CommandRepair(),

@@ -11,14 +11,20 @@ never executed), so that the conservative operators keep its end cell: without t
 ``x+`` before the goal with an ``x−`` after it would move where the child stops. ``trim_reached=False``
 keeps the genes whole.
 
-Six additions of ours are on by default, each switchable, and :meth:`HTetroGA.as_published` turns
-them all off:
+Eight additions of ours are on by default, each switchable (:meth:`HTetroGA.with_additions`, the
+names of :data:`~htetro_opt.algorithms.GA_ADDITIONS`), and :meth:`HTetroGA.as_published` turns them
+all off:
 
 - **repair** (:class:`~htetro_opt.operators.CommandRepair`): every new chromosome has its invalid
   commands replaced by valid ones, so children run their whole genes;
 - **shortcut** (:class:`~htetro_opt.operators.CommandShortcut`): the conservative set also cuts the
   longest loop out of each path;
+- **reach levels** of the goal-reachability sort (``reach_levels``): the members that do not reach
+  are sorted in one section per f_gr value, highest first, where the paper (§IV-C step 3) has two
+  sections, reached and not reached (:class:`~htetro_opt.operators.GoalReachabilitySurvival`);
 - **end-pose niching** of the goal-reachability sort (``niche_size``);
+- **gene cap** (``gene_cap``): crossover cuts each child to at most 2 l_p,max genes; the paper's
+  single-point crossover has no bound (:func:`~htetro_opt.operators.commands.crossover.cap_genes`);
 - **windowed exact re-planning** (:class:`~htetro_opt.operators.commands.CommandReplan`,
   ``replan_window`` and ``replan_members``): each generation, a window of up to W executed commands of
   the fastest goal-reaching member and of a few random reaching members is replaced by the minimum-time
@@ -57,9 +63,9 @@ terminations and pymoo's ask-and-tell interface (``_infill`` returns the offspri
 ``_advance`` takes them) work as with any pymoo algorithm. The offspring are counted in
 ``algorithm.evaluator.n_eval`` but do not pass through the evaluator (nor ``algorithm.off``).
 
-Measured on the paper's six maps (benchmarks/README.md), the published algorithm under MODEL.md's
-child termination rarely gets through the spiral's corridor or our random map in 1000 generations,
-and its best time stays well above the exact optimum; the additions fix both.
+Measured on the paper's six maps (docs/papers/cheng2020.md, the ``cheng2020_ablation`` study), the
+published algorithm under MODEL.md's child termination often fails to reach the goal in 1000
+generations, and its plans stay well above the exact optimum; each addition's share is measured there.
 """
 
 from __future__ import annotations
@@ -210,9 +216,15 @@ class HTetroGA(GeneticAlgorithm):
     shortcut : bool
         Cut the longest loop of each conservative offspring's path (ours, see
         :class:`~htetro_opt.operators.CommandShortcut`).
+    reach_levels : bool
+        Sort the members that do not reach in one section per f_gr value (ours; False = the paper's
+        two sections, see :class:`~htetro_opt.operators.GoalReachabilitySurvival`).
     niche_size : int
         End-pose niching of the goal-reachability sort (ours; 0 = the paper's sort as written, see
         :class:`~htetro_opt.operators.GoalReachabilitySurvival`).
+    gene_cap : bool
+        Cut crossover's children to 2 l_p,max genes (ours; False = the paper's unbounded crossover).
+        Ignored when ``crossover`` is given (that operator's own cap holds).
     replan_window : int
         W of the windowed exact re-planning (ours; 0 = off, see
         :class:`~htetro_opt.operators.commands.CommandReplan`).
@@ -274,6 +286,8 @@ class HTetroGA(GeneticAlgorithm):
         niche_size: int = 3,
         repair: bool = True,
         shortcut: bool = True,
+        reach_levels: bool = True,
+        gene_cap: bool = True,
         replan_window: int = 40,
         replan_members: int = 3,
         reach_share: float = 1.0,
@@ -284,13 +298,16 @@ class HTetroGA(GeneticAlgorithm):
         pop_size = check_int(pop_size, "pop_size", minimum=2)
         crossover_rate = check_probability(crossover_rate, "crossover_rate")
         repair = check_bool(repair, "repair")
+        self.gene_cap = check_bool(gene_cap, "gene_cap")
         super().__init__(
             pop_size=pop_size,
             sampling=sampling if sampling is not None else CommandSampling(),
             selection=RankAndCrowdingTournament(tournament_size),
-            crossover=crossover if crossover is not None else CommandCrossover(prob=1.0),
+            crossover=crossover if crossover is not None else
+            CommandCrossover(prob=1.0, length_cap=2 if self.gene_cap else None),
             mutation=mutation if mutation is not None else CommandMutation(),
-            survival=GoalReachabilitySurvival(niche_size=niche_size, reach_share=reach_share),
+            survival=GoalReachabilitySurvival(niche_size=niche_size, reach_share=reach_share,
+                                              levels=check_bool(reach_levels, "reach_levels")),
             eliminate_duplicates=CommandDuplicateElimination(),
             advance_after_initial_infill=True,
             repair=CommandRepair() if repair else None,
@@ -313,7 +330,10 @@ class HTetroGA(GeneticAlgorithm):
     @property
     def additions(self) -> tuple[str, ...]:
         """The additions of ours switched on (:data:`~htetro_opt.algorithms.GA_ADDITIONS`' names, in its order)."""
-        on = {"repair": isinstance(self.repair, CommandRepair), "shortcut": self.shortcut, "niching": self.survival.niche_size > 0,
+        capped = getattr(self.mating.crossover, "length_cap", None) is not None or \
+            getattr(self.mating.crossover, "max_genes", None) is not None
+        on = {"repair": isinstance(self.repair, CommandRepair), "shortcut": self.shortcut,
+              "reach-levels": self.survival.levels, "niching": self.survival.niche_size > 0, "gene-cap": capped,
               "replanning": self.replan is not None, "reach-repair": self.reach_repair is not None,
               "polish": self.polish_window > 0}
         return tuple(name for name in GA_ADDITIONS if on[name])
@@ -331,7 +351,8 @@ class HTetroGA(GeneticAlgorithm):
             If a name is not one of the additions.
         """
         additions = check_additions(additions)
-        off = {"repair": {"repair": False}, "shortcut": {"shortcut": False}, "niching": {"niche_size": 0},
+        off = {"repair": {"repair": False}, "shortcut": {"shortcut": False}, "reach-levels": {"reach_levels": False},
+               "niching": {"niche_size": 0}, "gene-cap": {"gene_cap": False},
                "replanning": {"replan_window": 0}, "reach-repair": {"reach_patience": 0},
                "polish": {"polish_window": 0}}
         options = dict(kwargs)
@@ -342,12 +363,13 @@ class HTetroGA(GeneticAlgorithm):
 
     @classmethod
     def as_published(cls, pop_size: int = 50, **kwargs) -> "HTetroGA":
-        """The hTetro-GA with none of our additions: no repair, no shortcut, no niching, no re-planning,
-        no reach repair, no balanced polish.
+        """The hTetro-GA with none of our additions: no repair, no shortcut, two sections in the sort (no
+        reach levels, no niching), no gene cap, no re-planning, no reach repair, no balanced polish.
 
         A keyword given here switches one back on (e.g. ``replan_window=40``).
         """
-        options = dict(repair=False, shortcut=False, niche_size=0, replan_window=0, reach_patience=0, polish_window=0)
+        options = dict(repair=False, shortcut=False, reach_levels=False, niche_size=0, gene_cap=False, replan_window=0,
+                       reach_patience=0, polish_window=0)
         options.update(kwargs)
         return cls(pop_size, **options)
 

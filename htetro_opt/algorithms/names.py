@@ -31,7 +31,10 @@ the former is not offered (the extremes of a front have infinite crowding distan
 GA_ADDITIONS = {
     "repair": "every new chromosome has its invalid commands replaced by valid ones, so children run their whole genes",
     "shortcut": "the conservative set also cuts the longest loop out of each path",
+    "reach-levels": "the goal-reachability sort splits the members that do not reach into one section per f_gr value, "
+                    "highest first (the paper: two sections, reached and not reached)",
     "niching": "end-pose niching of the goal-reachability sort (niche_size 3)",
+    "gene-cap": "crossover cuts each child to at most twice l_p,max genes (the paper: no cap)",
     "replanning": "each generation, windows of the fastest and of a few random goal-reaching members are replaced by "
                   "the minimum-time path between their ends (replan_window, replan_members)",
     "reach-repair": "when no member reaches and the best goal reachability stalls (reach_patience generations), the "
@@ -41,7 +44,7 @@ GA_ADDITIONS = {
 }
 """The hTetro-GA's additions of ours to Cheng et al. 2020's algorithm, by name, each switchable
 (:meth:`~htetro_opt.algorithms.HTetroGA.with_additions`): ``htetro-ga`` has them all, ``htetro-ga-paper``
-none."""
+none (docs/papers/cheng2020.md measures what each changes)."""
 
 EGA_ADDITIONS = {
     "delete-every-child": "deletion runs on every child and on the initial paths; the paper deletes the PBs of one "

@@ -18,6 +18,11 @@ Our environments are reconstructions (the paper's figures are not in our copy, s
 ``source``), so the generations and times need not match the paper's; the exact optimum is the
 reference that does not depend on the reconstruction.
 
+The study runs two methods beside the paper's numbers: ``htetro-ga-paper``, the paper's algorithm as
+published (its l_p,max, and the paper mode's patience of 10 generations, our reading of "the
+convergence of the solution"), and ``htetro-ga``, ours (our eight additions, patience 100). The
+report gives, for each environment and n_pop, the paper's row, the as-published run's and ours.
+
 Run from Python::
 
     from htetro_opt.studies import table4
@@ -51,6 +56,8 @@ from htetro_opt.model.robot import Pose
 from htetro_opt.model.simulate import Simulator
 from htetro_opt.scenarios import Scenario, load_scenario
 from htetro_opt.solvers.grid_paths import Plan, plan_exact, plan_ga
+from htetro_opt.solvers.grid_paths._spec import GA_PATIENCE
+from htetro_opt.solvers.grid_paths._spec import SPEC as PLAN_SPEC
 from htetro_opt.studies.metrics import (
     format_mean_std,
     group_records,
@@ -62,6 +69,7 @@ from htetro_opt.studies.runner import Study, StudyRun, Trial, run_study
 __all__ = [
     "ENVIRONMENTS",
     "MAX_LENGTH",
+    "METHODS",
     "PAPER_TABLE4",
     "POP_SIZES",
     "RECORD_FIELDS",
@@ -197,7 +205,9 @@ STUDY_METRICS = ("generations", "fitness", "gap")
 :func:`trial` takes: its record holds Table 4's generations and fitnesses, and ``"gap"`` makes the
 runner record each map's exact reference (Dijkstra over the whole roadmap) and the output plan's gap."""
 
-_PAPER_MAX_GEN, _PAPER_PATIENCE = 1000, 100
+_PAPER_MAX_GEN = 1000  # n_pop,max (§V-B3)
+METHODS = ("htetro-ga-paper", "htetro-ga")
+"""The methods the Table-4 study runs: the paper's algorithm as published, and ours."""
 _TRIAL_OPTIONS = ("pop_size", "max_gen", "patience", "max_length")
 _IN_HEAD = ("environment", "pop_size", "seed", "method", "max_gen", "patience", "max_length")
 # In a runner record "gap" and "reference" are the runner's (the output plan against the study's
@@ -219,6 +229,12 @@ def _check_method(method: Any) -> str:
     if method not in GA_ALGORITHMS:
         raise ParameterError(f"unknown method {method!r}: expected one of {', '.join(GA_ALGORITHMS)}")
     return str(method)
+
+
+def _patience(method: str) -> int:
+    """The method's own patience (the grid-path spec's: 10 for htetro-ga-paper), else the GAs' default."""
+    own = PLAN_SPEC.default_of(method, "patience")
+    return GA_PATIENCE["best"] if own is None else own
 
 
 def _check_list(values: Any, name: str) -> list:
@@ -323,8 +339,8 @@ def _measure(environment, pop_size, seed, *, max_gen, patience, method, max_leng
     pop_size = check_int(pop_size, "pop_size", minimum=2)
     seed = check_int(seed, "seed", minimum=0)
     max_gen = check_int(max_gen, "max_gen", minimum=1)
-    patience = check_int(patience, "patience", minimum=1)
     method = _check_method(method)
+    patience = check_int(_patience(method) if patience is None else patience, "patience", minimum=1)
     max_length = MAX_LENGTH[environment] if max_length is None else check_int(max_length, "max_length", minimum=1)
     scenario, sim = _environment(environment)
     roadmap = list(scenario.roadmap)
@@ -342,7 +358,7 @@ def run_trial(
     seed: int,
     *,
     max_gen: int = _PAPER_MAX_GEN,
-    patience: int = _PAPER_PATIENCE,
+    patience: int | None = None,
     method: str = "htetro-ga",
     max_length: int | None = None,
 ) -> dict:
@@ -360,7 +376,8 @@ def run_trial(
         wall-clock fields (:data:`TIME_FIELDS`) aside.
     max_gen, patience : int, keyword-only
         Termination per leg: at most ``max_gen`` generations, or ``patience`` generations without
-        improvement once the goal is reached.
+        improvement once the goal is reached (default the method's: 10 for ``"htetro-ga-paper"``,
+        100 for the others, see :func:`~htetro_opt.solvers.grid_paths.plan_ga`).
     method : str, keyword-only
         One of :data:`~htetro_opt.algorithms.GA_ALGORITHMS` (default the paper's hTetro-GA with our
         additions; ``"htetro-ga-paper"`` runs it as published).
@@ -485,7 +502,7 @@ def trial(task: str, scenario: str, method: str, parameters: Mapping[str, Any], 
     parameters = _check_trial_parameters(parameters)
     measured, plan = _measure(scenario, parameters["pop_size"], seed, method=method,
                               max_gen=parameters.get("max_gen", _PAPER_MAX_GEN),
-                              patience=parameters.get("patience", _PAPER_PATIENCE),
+                              patience=parameters.get("patience"),
                               max_length=parameters.get("max_length"))
     record = Trial(task, scenario, method, parameters, seed, method if label is None else label,
                    tuple(metrics)).head()
@@ -509,11 +526,11 @@ def table4_study(
     seeds: int | Sequence[int] = 50,
     *,
     max_gen: int = _PAPER_MAX_GEN,
-    patience: int = _PAPER_PATIENCE,
-    method: str = "htetro-ga",
+    patience: int | None = None,
+    method: str | Sequence[str] = METHODS,
 ) -> Study:
-    """The Table-4 study for the runner: each environment × population size × seed, l_p,max per
-    :data:`MAX_LENGTH`. With the defaults it is the bundled study ``table4``
+    """The Table-4 study for the runner: each method × population size, each environment × seed,
+    l_p,max per :data:`MAX_LENGTH`. With the defaults it is the bundled study ``table4``
     (``load_study("table4")``); run it with ``run_study(study, trial=trial)``.
 
     Parameters
@@ -524,8 +541,11 @@ def table4_study(
         One method entry each, labelled ``"<method>, n_pop <n>"`` (an int: one).
     seeds : int or sequence of int
         N for seeds 0 … N−1, or the seeds (the paper ran 50).
-    max_gen, patience, method : keyword-only
-        As for :func:`run_trial`.
+    max_gen, patience : keyword-only
+        As for :func:`run_trial` (patience: each method's own by default, written into its entries).
+    method : str or sequence of str, keyword-only
+        The methods, each one of :data:`~htetro_opt.algorithms.GA_ALGORITHMS` (default :data:`METHODS`:
+        the paper's as published, then ours).
 
     Returns
     -------
@@ -539,24 +559,26 @@ def table4_study(
 
     Examples
     --------
-    >>> study = table4_study(["three_slit"], [12, 25], 2, max_gen=5)
+    >>> study = table4_study(["three_slit"], [12, 25], 2, max_gen=5, method="htetro-ga")
     >>> [(t.label, t.seed, t.parameters["max_gen"]) for t in study.trials()][:3]
     [('htetro-ga, n_pop 12', 0, 5), ('htetro-ga, n_pop 12', 1, 5), ('htetro-ga, n_pop 25', 0, 5)]
     """
     environments = [_check_environment(e) for e in _check_list(environments, "environments")]
     pop_sizes = [check_int(n, "pop_size", minimum=2) for n in _check_list(pop_sizes, "pop_sizes")]
-    method = _check_method(method)
+    methods = [_check_method(m) for m in _check_list(method, "method")]
     max_gen = check_int(max_gen, "max_gen", minimum=1)
-    patience = check_int(patience, "patience", minimum=1)
+    patience = check_int(patience, "patience", minimum=1, allow_none=True)
     common = statistics.mode(MAX_LENGTH.values())  # 100 for the method entry; the spiral's 200 per map
     per_scenario = {e: {"max_length": MAX_LENGTH[e]} for e in environments if MAX_LENGTH[e] != common}
-    methods = [{"label": f"{method}, n_pop {n}", "method": method, "pop_size": n, "max_gen": max_gen,
-                "patience": patience, "max_length": common, **({"per_scenario": per_scenario} if per_scenario else {})}
-               for n in pop_sizes]
-    return Study(name="table4", task="plan", scenarios=environments, methods=methods,
+    entries = [{"label": f"{m}, n_pop {n}", "method": m, "pop_size": n, "max_gen": max_gen,
+                "patience": _patience(m) if patience is None else patience, "max_length": common,
+                **({"per_scenario": per_scenario} if per_scenario else {})}
+               for m in methods for n in pop_sizes]
+    return Study(name="table4", task="plan", scenarios=environments, methods=entries,
                  seeds=seeds if isinstance(seeds, numbers.Integral) else list(_check_list(seeds, "seeds")),
                  metrics=STUDY_METRICS,
-                 description="Cheng et al. 2020, Table 4: hTetro-GA over six maps and three population sizes")
+                 description="Cheng et al. 2020, Table 4: hTetro-GA as published and ours over six maps and three "
+                             "population sizes")
 
 
 def run_table4(
@@ -565,8 +587,8 @@ def run_table4(
     seeds: int | Sequence[int] = 50,
     *,
     max_gen: int = _PAPER_MAX_GEN,
-    patience: int = _PAPER_PATIENCE,
-    method: str = "htetro-ga",
+    patience: int | None = None,
+    method: str | Sequence[str] = METHODS,
     executor: str = "processes",
     workers: int | None = None,
     out: str | os.PathLike | None = None,
@@ -695,43 +717,63 @@ def _number(value: float | None, digits: int = 1) -> str:
     return f"{value:g}" if float(value).is_integer() else f"{value:.{digits}f}"
 
 
-def markdown_table(summary: Iterable[Mapping[str, Any]]) -> str:
-    """A markdown table of :func:`summarise` rows: ours as "mean ± std", the paper's in brackets.
+_SOURCES = {"htetro-ga-paper": "as published (htetro-ga-paper)", "htetro-ga": "ours (htetro-ga)"}
+_PAPER_SOURCE = "Cheng et al. 2020, Table 4"
+_PAPER_RUNS = 50  # Table 4's trials per row; its f_gr = 1.000 ± 0.000 everywhere: every output reached
 
-    Columns: environment, n_pop, the method (only when the rows hold more than one), runs, errors
-    (only when some trial raised), reached (of runs), reach and terminate generation, reach and
-    terminate time, f_t, f_sm, f_sf (each "ours (paper)"), the exact optimum time, the best GA time
-    (mean ± std over the runs that reached) and the gap of the best GA time to the optimum (mean, and
-    the largest in brackets).
+
+def _source_order(method) -> tuple:
+    return (list(_SOURCES).index(method) if method in _SOURCES else len(_SOURCES), str(method or ""))
+
+
+def markdown_table(summary: Iterable[Mapping[str, Any]]) -> str:
+    """A markdown table of :func:`summarise` rows: for each environment and n_pop, the paper's row
+    (Cheng et al. 2020's Table 4, where it has that n_pop), then the as-published run
+    (``htetro-ga-paper``), ours (``htetro-ga``) and any other method, each as "mean ± std".
+
+    Columns: environment, n_pop, source, runs, errors (only when some trial raised), reached (of
+    runs), reach and terminate generation, reach and terminate time, f_t, f_sm, f_sf, the exact
+    optimum time, the best GA time (mean ± std over the runs that reached) and the gap of the best
+    GA time to the optimum (mean, and the largest in brackets); the paper measured no optimum.
 
     Examples
     --------
     >>> text = markdown_table(summarise([{"scenario": "three_slit", "pop_size": 50, "f_gr": 1.0,
-    ...     "reach_generation": 200, "best_time": 36.0, "exact_time": 33.0, "best_gap": 3 / 33}]))
-    >>> "| three_slit | 50 | 1 | 1/1 | 200.00 (210.60 ± 27.56) |" in text
-    True
+    ...     "method": "htetro-ga-paper", "reach_generation": 200, "best_time": 36.0, "exact_time": 33.0,
+    ...     "best_gap": 3 / 33}]))
+    >>> for line in text.splitlines()[2:]:
+    ...     print(" | ".join(line.split(" | ")[:6]))
+    | three_slit | 50 | Cheng et al. 2020, Table 4 | 50 | 50/50 | 210.60 ± 27.56
+    | three_slit | 50 | as published (htetro-ga-paper) | 1 | 1/1 | 200.00
     """
-    summary = list(summary)
-    several = len({row.get("method") for row in summary}) > 1
+    summary = sorted(summary, key=lambda row: (_order((row["environment"], row["pop_size"], None))[:3],
+                                               _source_order(row.get("method"))))
     errors = any(row.get("errors") for row in summary)
-    header = (["environment", "n_pop"] + (["method"] if several else []) + ["runs"]
-              + (["errors"] if errors else []) + ["reached"])
+    header = ["environment", "n_pop", "source", "runs"] + (["errors"] if errors else []) + ["reached"]
     lead = len(header)
-    header += [f"{label}, ours (paper)" for _, label, _ in _MD_COLUMNS]
+    header += [label for _, label, _ in _MD_COLUMNS]
     header += ["exact optimum", "best GA time", "gap to optimum"]
-    aligns = ["---", "---:"] + (["---"] if several else []) + ["---:"] * (len(header) - 2 - several)
+    aligns = ["---", "---:", "---"] + ["---:"] * (len(header) - 3)
     lines = ["| " + " | ".join(header) + " |", "|" + "|".join(aligns) + "|"]
+    done = set()
     for row in summary:
-        cells = [str(row["environment"]), str(row["pop_size"])]
-        cells += [str(row.get("method"))] if several else []
+        group = (row["environment"], row["pop_size"])
+        if group not in done and row.get(f"paper_{_MD_COLUMNS[0][0]}_mean") is not None:
+            cells = [str(row["environment"]), str(row["pop_size"]), _PAPER_SOURCE, str(_PAPER_RUNS)]
+            cells += ["–"] if errors else []
+            cells += [f"{_PAPER_RUNS}/{_PAPER_RUNS}"]
+            cells += [format_mean_std(row.get(f"paper_{column}_mean"), row.get(f"paper_{column}_std"), digits=digits)
+                      for column, _, digits in _MD_COLUMNS]
+            cells += ["–", "–", "–"]
+            lines.append("| " + " | ".join(cells) + " |")
+        done.add(group)
+        method = row.get("method")
+        cells = [str(row["environment"]), str(row["pop_size"]), _SOURCES.get(method, str(method))]
         cells += [str(row["runs"])] + ([str(row.get("errors", 0))] if errors else [])
         cells += [f"{row['reached']}/{row['runs']}"]
         assert len(cells) == lead
-        for column, _, digits in _MD_COLUMNS:
-            ours = format_mean_std(row.get(f"{column}_mean"), row.get(f"{column}_std"), digits=digits)
-            paper = format_mean_std(row.get(f"paper_{column}_mean"), row.get(f"paper_{column}_std"),
-                                    digits=digits)
-            cells.append(f"{ours} ({paper})")
+        cells += [format_mean_std(row.get(f"{column}_mean"), row.get(f"{column}_std"), digits=digits)
+                  for column, _, digits in _MD_COLUMNS]
         lo, hi = row.get("exact_time_min"), row.get("exact_time_max")
         cells.append(_number(lo) if lo == hi else f"{_number(lo)}–{_number(hi)}")
         cells.append(format_mean_std(row.get("best_time_mean"), row.get("best_time_std"), digits=1))
@@ -742,8 +784,8 @@ def markdown_table(summary: Iterable[Mapping[str, Any]]) -> str:
 
 
 def report(run: StudyRun) -> str:
-    """The Markdown Table 4 of a run of the Table-4 study: ours beside the paper's, the exact optimum
-    and the gap (:func:`markdown_table` of :func:`summarise`).
+    """The Markdown Table 4 of a run of the Table-4 study: the paper's numbers, the as-published run and
+    ours, the exact optimum and the gap (:func:`markdown_table` of :func:`summarise`).
 
     Raises
     ------

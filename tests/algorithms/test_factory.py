@@ -69,10 +69,12 @@ def test_agemoea_without_numba_is_a_clear_error(monkeypatch):
         make_algorithm("agemoea", 12)
 
 
-@pytest.mark.parametrize("name", ["htetro-ga", "htetro-ga-paper"])
-def test_reach_share_reaches_the_htetro_ga_sort(name):
-    assert make_algorithm(name, 20).survival.reach_share == 1.0
-    assert make_algorithm(name, 20, reach_share=0.6).survival.reach_share == 0.6
+def test_reach_share_reaches_the_htetro_ga_sort_and_the_paper_mode_refuses_it():
+    assert make_algorithm("htetro-ga", 20).survival.reach_share == 1.0
+    assert make_algorithm("htetro-ga", 20, reach_share=0.6).survival.reach_share == 0.6
+    assert make_algorithm("htetro-ga-paper", 20, reach_share=1.0).survival.reach_share == 1.0  # no cap: the paper's
+    with pytest.raises(ParameterError, match="htetro-ga-paper refuses it"):
+        make_algorithm("htetro-ga-paper", 20, reach_share=0.6)  # ours, not an addition
 
 
 @pytest.mark.parametrize("share, name, word", [(0.0, "htetro-ga", "reach_share"), (1.1, "htetro-ga-paper", "reach_share"),

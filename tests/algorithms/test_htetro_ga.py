@@ -217,8 +217,8 @@ def test_replanning_keeps_the_run_reproducible_and_leaves_the_paper_variant_alon
     b = minimize(problem, HTetroGA(pop_size=16, replan_window=8), ("n_gen", 8), seed=2)
     assert population_arrays(a)[1] == population_arrays(b)[1]
     paper = minimize(problem, HTetroGA.as_published(16), ("n_gen", 8), seed=2)
-    off = minimize(problem, HTetroGA(16, repair=False, shortcut=False, niche_size=0, replan_window=0, polish_window=0),
-                   ("n_gen", 8), seed=2)
+    off = minimize(problem, HTetroGA(16, repair=False, shortcut=False, reach_levels=False, niche_size=0, gene_cap=False,
+                                     replan_window=0, reach_patience=0, polish_window=0), ("n_gen", 8), seed=2)
     assert population_arrays(paper)[1] == population_arrays(off)[1]
 
 

@@ -233,7 +233,7 @@ def test_crossover_cut_points_are_independent_and_uniform():
     assert all(50 < n < 150 for n in pairs.values())
 
 
-def test_crossover_operator_caps_at_twice_max_length():
+def test_crossover_operator_caps_only_when_asked():
     class Stub:
         n_var, max_length = 1, 3
 
@@ -241,7 +241,10 @@ def test_crossover_operator_caps_at_twice_max_length():
     matings = np.column_stack([np.arange(50), np.arange(50, 100)])
     off = CommandCrossover().do(Stub(), pop, matings, random_state=np.random.default_rng(3))
     lengths = [len(x) for x in sequences(off.get("X"))]
-    assert len(lengths) == 100 and max(lengths) == 6 and min(lengths) < 6
+    assert len(lengths) == 100 and max(lengths) > 6 and sum(lengths) == 600  # the paper's: no cap, genes kept
+    off = CommandCrossover(length_cap=2).do(Stub(), pop, matings, random_state=np.random.default_rng(3))
+    lengths = [len(x) for x in sequences(off.get("X"))]
+    assert len(lengths) == 100 and max(lengths) == 6 and min(lengths) < 6  # twice l_p,max (the gene-cap addition)
     assert max(len(x) for x in sequences(CommandCrossover(max_genes=4).do(
         Stub(), pop, matings, random_state=np.random.default_rng(3)).get("X"))) == 4
 
@@ -536,21 +539,24 @@ def test_tournament_examples():
 LEVELS = [1.0, 0.5, 1 / 3, 0.25, 0.0]
 
 
-def effective_levels(F, end, niche_size):
-    """−f_gr, with the unreached individuals beyond the ``niche_size`` best of their end pose put after every level."""
-    levels = F[:, 0].copy()
+def effective_levels(F, end, niche_size, levels=True):
+    """The sections in order: with ``levels`` −f_gr (the reach levels, ours), else the paper's two (−1 for the goal-
+    reaching individuals, 0 for the others); the unreached individuals beyond the ``niche_size`` best of their end
+    pose after every section."""
+    sections = F[:, 0].copy() if levels else np.where(F[:, 0] == -1.0, -1.0, 0.0)
     if niche_size:
         for e in np.unique(end):
             group = np.flatnonzero((end == e) & (F[:, 0] != -1.0))
             order = group[np.argsort(F[group, 1:].sum(axis=1), kind="stable")]
-            levels[order[niche_size:]] += 2.0
-    return levels
+            sections[order[niche_size:]] += 2.0
+    return sections
 
 
+@pytest.mark.parametrize("levels", [False, True])
 @pytest.mark.parametrize("niche_size", [0, 1, 3])
 @settings(max_examples=60, deadline=None)
 @given(data=st.data(), n=st.integers(1, 25), seed=seeds)
-def test_goal_reachability_survival(niche_size, data, n, seed):
+def test_goal_reachability_survival(niche_size, levels, data, n, seed):
     f_gr = np.array(data.draw(st.lists(st.sampled_from(LEVELS), min_size=n, max_size=n)))
     n_survive = data.draw(st.integers(1, n + 3))
     rng = np.random.default_rng(seed)
@@ -560,8 +566,8 @@ def test_goal_reachability_survival(niche_size, data, n, seed):
     pop = Population.new("X", as_column([[i] for i in range(n)]), "F", F)
     pop.set("idx", np.arange(n), "end", end)
     problem = Problem(n_var=1, n_obj=4)
-    survivors = GoalReachabilitySurvival(niche_size=niche_size).do(problem, pop, n_survive=n_survive,
-                                                                   random_state=rng)
+    survivors = GoalReachabilitySurvival(niche_size=niche_size, levels=levels).do(problem, pop, n_survive=n_survive,
+                                                                                 random_state=rng)
     assert len(survivors) == min(n, n_survive)
     idx = survivors.get("idx").astype(int)
     assert len(set(idx.tolist())) == len(idx)
@@ -569,7 +575,7 @@ def test_goal_reachability_survival(niche_size, data, n, seed):
     rank, crowding = survivors.get("rank"), survivors.get("crowding")
     assert all(r is not None and int(r) >= 0 for r in rank)
     assert all(c is not None and not np.isnan(float(c)) for c in crowding)
-    level = effective_levels(F, end, niche_size)
+    level = effective_levels(F, end, niche_size, levels)
     lost = np.setdiff1d(np.arange(n), idx)
     n_goal = int((f_gr == 1).sum())
     assert (f_gr[idx] == 1).sum() == min(n_goal, n_survive)  # individuals reaching the goal survive first

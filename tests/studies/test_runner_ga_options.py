@@ -33,8 +33,7 @@ def test_ga_options_are_taken_and_reach_the_planner():
 @pytest.mark.parametrize("method", ["nsga2", "smsemoa"])
 def test_pymoo_algorithms_take_every_ga_option_but_the_reaching_share(method):
     _study(method=method, pick="safest", convergence="best", seed_exact=True, replan_window=40, replan_members=2)
-    with pytest.raises(StudyError, match=r"methods\[0\]: reach_share applies to the hTetro-GA methods "
-                                         rf"\(htetro-ga, htetro-ga-paper\) only, not to {method}"):
+    with pytest.raises(StudyError, match=rf"methods\[0\]: reach_share applies to htetro-ga only, not to {method}"):
         _study(method=method, reach_share=1.0)
 
 
@@ -69,7 +68,7 @@ def test_pymoo_algorithm_records_the_conservative_run():
 @pytest.mark.parametrize("method", ["dijkstra", "exact", "astar", "heat"])
 @pytest.mark.parametrize("key, value", sorted(OPTIONS.items()))
 def test_exact_and_heat_methods_refuse_every_ga_option_by_name(method, key, value):
-    with pytest.raises(StudyError, match=rf"methods\[0\]: {key} applies to the "):
+    with pytest.raises(StudyError, match=rf"methods\[0\]: {key} applies to .* only, not to "):
         _study(method=method, **{key: value})
 
 

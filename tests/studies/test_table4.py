@@ -61,7 +61,8 @@ PAPER_TABLE4_TEXT = (
 # A run_trial field under its name in a runner record (the runner owns "gap"; "time" is its name for
 # the output plan's time; the head holds the environment as "scenario").
 RENAMED = {"environment": "scenario", "plan_time": "time", "gap": "best_gap"}
-TINY = {"environments": ["three_slit", "random"], "pop_sizes": [12, 25], "seeds": 2, "max_gen": 20}
+TINY = {"environments": ["three_slit", "random"], "pop_sizes": [12, 25], "seeds": 1, "max_gen": 20}
+METHODS = ("htetro-ga-paper", "htetro-ga")  # the study's: the paper's as published, then ours
 
 
 def _content(records):
@@ -165,6 +166,9 @@ def test_run_trial_is_deterministic_and_validates():
 # --- the trial on the study runner ---------------------------------------------------------------
 def test_bundled_study_is_table4_study():
     assert table4_study() == load_study("table4")  # the study file and the Python study agree
+    # the paper's algorithm as published (the paper mode's patience) beside ours, at each n_pop
+    assert [(m.method, m.options["pop_size"], m.options["patience"]) for m in table4_study().methods] == [
+        ("htetro-ga-paper", n, 10) for n in (25, 50, 100)] + [("htetro-ga", n, 100) for n in (25, 50, 100)]
     small = table4_study(["spiral", "three_slit"], 25, [4, 7], max_gen=9, patience=3, method="htetro-ga-paper")
     assert [(t.scenario, t.seed, t.parameters) for t in small.trials()] == [
         (s, seed, {"max_gen": 9, "max_length": MAX_LENGTH[s], "patience": 3, "pop_size": 25})
@@ -184,11 +188,12 @@ def test_runner_records_are_run_trials(serial):
     study = table4_study(**TINY)
     records = serial.records
     assert [r["key"] for r in records] == [t.key for t in study.trials()]
-    assert [(r["scenario"], r["pop_size"], r["seed"]) for r in records] == [
-        (e, n, s) for e in ("three_slit", "random") for n in (12, 25) for s in (0, 1)]
+    assert [(r["scenario"], r["method"], r["pop_size"], r["seed"]) for r in records] == [
+        (e, m, n, 0) for e in ("three_slit", "random") for m in METHODS for n in (12, 25)]
     for record in records:
-        assert record["error"] is None and record["label"] == f"htetro-ga, n_pop {record['pop_size']}"
-        direct = run_trial(record["scenario"], record["pop_size"], record["seed"], max_gen=20)
+        assert record["error"] is None and record["label"] == f"{record['method']}, n_pop {record['pop_size']}"
+        assert record["patience"] == {"htetro-ga-paper": 10, "htetro-ga": 100}[record["method"]]
+        direct = run_trial(record["scenario"], record["pop_size"], record["seed"], max_gen=20, method=record["method"])
         assert {k: v for k, v in _content([direct])[0].items()} == {
             k: record[RENAMED.get(k, k)] for k in _content([direct])[0]}
         # the runner's reference is the exact optimum (oracle: plan_exact), its gap the output plan's
@@ -207,7 +212,7 @@ def test_runner_records_are_run_trials(serial):
 
 
 def test_trial_key_is_the_runner_trial_key():
-    study = table4_study(["three_slit"], [12], [5], max_gen=3)
+    study = table4_study(["three_slit"], [12], [5], max_gen=3, method="htetro-ga")
     (t,) = study.trials()
     record = trial(t.task, t.scenario, t.method, t.parameters, t.seed, label=t.label, metrics=t.metrics)
     assert record["key"] == t.key and record["seed"] == 5 and record["max_gen"] == 3
@@ -251,26 +256,36 @@ def test_resume_runs_only_what_is_missing(serial, tmp_path):
     assert again.resumed == 10 and len(read_records(path)) == 10  # nothing left to run
 
 
-def test_report_puts_ours_beside_the_papers(serial):
+def test_report_puts_the_paper_the_as_published_run_and_ours_side_by_side(serial):
     text = report(serial)
     lines = text.splitlines()
-    assert lines[0].startswith("| environment | n_pop | runs | reached | reach gen, ours (paper) |")
-    assert [line.split(" | ")[:2] for line in lines[2:]] == [  # in the paper's row order
-        ["| random", "12"], ["| random", "25"], ["| three_slit", "12"], ["| three_slit", "25"]]
-    slit25 = lines[5]
-    assert "(374.02 ± 35.17) |" in slit25 and "(0.444 ± 0.027) |" in slit25  # the paper's, n_pop 25
-    assert "(–) |" in lines[4]  # the paper has no n_pop 12
-    assert " | 33 | " in slit25 and " | 36 | " in lines[3]  # the exact optima
-    reached = [r for r in serial.records if r["scenario"] == "random" and r["pop_size"] == 12 and r["reached"]]
-    gaps = [100 * r["best_gap"] for r in reached]
-    assert lines[2].endswith(f"| {sum(gaps) / len(gaps):.1f} % (max {max(gaps):.1f} %) |")
+    assert lines[0].startswith("| environment | n_pop | source | runs | reached | reach gen | terminate gen |")
+    cells = [line.split(" | ") for line in lines[2:]]
+    paper, published, ours = "Cheng et al. 2020, Table 4", "as published (htetro-ga-paper)", "ours (htetro-ga)"
+    assert [c[:3] for c in cells] == [  # in the paper's row order; the paper has no n_pop 12
+        ["| random", "12", published], ["| random", "12", ours],
+        ["| random", "25", paper], ["| random", "25", published], ["| random", "25", ours],
+        ["| three_slit", "12", published], ["| three_slit", "12", ours],
+        ["| three_slit", "25", paper], ["| three_slit", "25", published], ["| three_slit", "25", ours]]
+    slit25 = lines[2 + 7]
+    assert "| 374.02 ± 35.17 |" in slit25 and "| 0.444 ± 0.027 |" in slit25  # the paper's, n_pop 25
+    assert slit25.endswith("| – | – | – |")  # the paper measured no optimum
+    assert " | 33 | " in lines[2 + 8] and " | 36 | " in lines[2 + 1]  # the exact optima beside the runs
+    for row, (scenario, method) in ((2 + 1, ("random", "htetro-ga")), (2 + 5, ("three_slit", "htetro-ga-paper"))):
+        reached = [r for r in serial.records if r["scenario"] == scenario and r["pop_size"] == 12
+                   and r["method"] == method and r["reached"]]
+        if reached:
+            gaps = [100 * r["best_gap"] for r in reached]
+            assert lines[row].endswith(f"| {sum(gaps) / len(gaps):.1f} % (max {max(gaps):.1f} %) |")
+    assert len({line.count("|") for line in lines}) == 1
     # the results file holds the references too: the summary leaves them out
     assert summarise(read_records(serial.path)) == summarise(serial.records)
     assert text == markdown_table(summarise(serial.records))
 
 
 def test_report_refuses_records_of_another_trial():
-    generic = run_study(table4_study(["three_slit"], [12], 1, max_gen=3), executor="serial")  # no trial=
+    generic = run_study(table4_study(["three_slit"], [12], 1, max_gen=3, method="htetro-ga"),
+                        executor="serial")  # no trial=
     with pytest.raises(ParameterError, match="trial=htetro_opt.studies.table4.trial"):
         report(generic)
     with pytest.raises(ParameterError, match="StudyRun"):
@@ -288,8 +303,8 @@ def test_errors_are_recorded_and_counted():
     assert [(r["environment"], r["runs"], r["errors"], r["reached"]) for r in rows] == [
         ("three_slit", 1, 0, 0), ("maze", 1, 1, 0)]
     lines = report(run).splitlines()
-    assert lines[0].startswith("| environment | n_pop | runs | errors | reached |")
-    assert lines[3].startswith("| maze | 12 | 1 | 1 | 0/1 | – (–) |")
+    assert lines[0].startswith("| environment | n_pop | source | runs | errors | reached |")
+    assert lines[3].startswith("| maze | 12 | ours (htetro-ga) | 1 | 1 | 0/1 | – |")
     assert len({line.count("|") for line in lines}) == 1
 
 
@@ -356,19 +371,24 @@ def test_summarise_synthetic():
 
 
 def test_markdown_table_synthetic():
-    text = markdown_table(summarise(_synthetic()))
-    lines = text.strip().splitlines()
-    assert len(lines) == 4
-    assert lines[0].startswith("| environment | n_pop | runs | reached | reach gen, ours (paper) |")
-    assert lines[0].count("|") == lines[1].count("|") == lines[3].count("|")
-    slit = lines[3]
-    assert slit.startswith("| three_slit | 50 | 3 | 2/3 | 200.00 ± 141.42 (210.60 ± 27.56) |")
-    assert "| 0.650 ± 0.071 (0.442 ± 0.031) |" in slit
+    records = _synthetic() + [dict(_synthetic()[0], method="htetro-ga-paper", f_t=0.5, best_time=39.0,
+                                   best_gap=6 / 33)]
+    lines = markdown_table(summarise(records)).strip().splitlines()
+    assert len(lines) == 2 + 2 + 3  # random: the paper's row and ours; three_slit: the paper's, as published, ours
+    assert lines[0].startswith("| environment | n_pop | source | runs | reached | reach gen |")
+    assert len({line.count("|") for line in lines}) == 1
+    assert lines[2].startswith("| random | 25 | Cheng et al. 2020, Table 4 | 50 | 50/50 | 2.88 ± 0.49 |")
+    assert lines[3].startswith("| random | 25 | ours (htetro-ga) | 1 | 1/1 | 3.00 |")
+    assert lines[4].startswith("| three_slit | 50 | Cheng et al. 2020, Table 4 | 50 | 50/50 | 210.60 ± 27.56 |")
+    assert "| 0.442 ± 0.031 |" in lines[4]
+    assert lines[5].startswith("| three_slit | 50 | as published (htetro-ga-paper) | 1 | 1/1 | 100.00 |")
+    assert lines[5].endswith("| 33 | 39.0 | 18.2 % (max 18.2 %) |")
+    slit = lines[6]
+    assert slit.startswith("| three_slit | 50 | ours (htetro-ga) | 3 | 2/3 | 200.00 ± 141.42 |")
+    assert "| 0.650 ± 0.071 |" in slit
     assert slit.endswith("| 33 | 34.5 ± 2.1 | 4.5 % (max 9.1 %) |")
-    assert "| random | 25 | 1 | 1/1 | 3.00 (2.88 ± 0.49) |" in lines[2]
     mixed = markdown_table(summarise(_synthetic() + [dict(_synthetic()[0], method="nsga2")])).splitlines()
-    assert mixed[0].startswith("| environment | n_pop | method | runs | reached |")
-    assert mixed[4].startswith("| three_slit | 50 | nsga2 | 1 | 1/1 |")
+    assert mixed[-1].startswith("| three_slit | 50 | nsga2 | 1 | 1/1 |")
     assert len({line.count("|") for line in mixed}) == 1
 
 

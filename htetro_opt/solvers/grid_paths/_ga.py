@@ -182,7 +182,9 @@ def plan_ga(
     max_gen, patience : int, keyword-only
         Termination (:class:`~htetro_opt.algorithms.FrontConvergence`): at most ``max_gen``
         generations per leg, or ``patience`` generations without improvement once the goal is reached
-        (default 100 with ``convergence="best"``, 20 with ``"hypervolume"``).
+        (default 100 with ``convergence="best"``, 20 with ``"hypervolume"``; ``"htetro-ga-paper"``: 10,
+        our reading of the paper's "convergence of the solution",
+        :data:`~htetro_opt.solvers.grid_paths._spec.PAPER_PATIENCE`).
     convergence : {"best", "hypervolume"}, keyword-only
         What counts as an improvement (:class:`~htetro_opt.algorithms.FrontConvergence`'s ``measure``):
         a rise of the best f_t, f_sm, f_sf or fitness sum among the goal-reaching individuals (the
@@ -194,7 +196,9 @@ def plan_ga(
         hundreds of generations.
     max_length : int, optional, keyword-only
         l_p,max, the length of the initial chromosomes and, through t_max, the scale of f_t (the
-        paper: 100, 200 for its spiral map). By default, per leg, from the leg's exact minimum time
+        paper: 100, 200 for its spiral map). ``"htetro-ga-paper"``: 100 by default
+        (:data:`~htetro_opt.solvers.grid_paths._spec.PAPER_MAX_LENGTH`). Otherwise by default, per
+        leg, from the leg's exact minimum time
         (:func:`default_max_length`: the paper's 100 and 200 on its maps, more on larger ones; ours: a
         fixed 100 is shorter than any path on a large map, and f_t goes negative).
     seed : None, int or numpy.random.Generator, keyword-only
@@ -226,7 +230,7 @@ def plan_ga(
         from the leg's start at its time) into the leg's initial population, so that the GA spends its
         generations on the f_sm / f_sf trade-off; the plan's ``info["exact_times"]`` then lists each
         leg's optimum (None where a leg has no path). Off by default: the GA's own search is what is
-        measured.
+        measured. Ours: ``"htetro-ga-paper"`` refuses it.
     pick : {"balanced", "fastest", "smoothest", "safest"}, keyword-only
         The solution each leg chains (:data:`~htetro_opt.algorithms.PICKS`): the leading-front member
         with the largest sum of the four fitnesses (the paper's multi-objective based solution; the
@@ -297,6 +301,14 @@ def plan_ga(
                              polish_window=polish_window, additions=additions)  # validates
     on = _additions_of(checked)
     seed_exact = check_bool(seed_exact, "seed_exact")
+    if seed_exact and algorithm == "htetro-ga-paper":
+        raise ParameterError("seed_exact puts the exact plan into the initial population, which the paper draws by its "
+                             "Algorithm 1 alone: htetro-ga-paper refuses it, htetro-ga takes it")
+    own = SPEC.method(algorithm).defaults  # the method's own defaults (htetro-ga-paper: the paper's l_p,max, patience)
+    if patience is None:
+        patience = own.get("patience")
+    if max_length is None:
+        max_length = own.get("max_length")
     if not isinstance(pick, str) or pick not in PICKS:
         raise ParameterError(f"pick must be one of {', '.join(PICKS)}, got {pick!r}")
     max_gen = check_int(max_gen, "max_gen", minimum=1)

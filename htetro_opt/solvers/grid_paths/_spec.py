@@ -26,7 +26,8 @@ from htetro_opt._validation import check_bool, check_int, check_time_limit
 from htetro_opt.algorithms import CONVERGENCE_MEASURES, GA_ADDITIONS, PICKS
 from htetro_opt.errors import ParameterError, PlanningError, ScenarioError
 
-__all__ = ["SPEC", "HEAT_ADDITIONS", "HEAT_ELEMENTS", "HEAT_ENGINES", "BAND_SEEDS", "GA_PATIENCE", "TABLE6_WEIGHTS"]
+__all__ = ["SPEC", "HEAT_ADDITIONS", "HEAT_ELEMENTS", "HEAT_ENGINES", "BAND_SEEDS", "GA_PATIENCE", "PAPER_MAX_LENGTH",
+           "PAPER_PATIENCE", "TABLE6_WEIGHTS"]
 
 HEAT_ADDITIONS = {
     "pinch-split": "the field's bilinear mesh gives a node where two free cells touch only at a corner one copy "
@@ -64,6 +65,16 @@ BAND_SEEDS = ("ascent", "grid_distance")
 
 GA_PATIENCE = {"best": 100, "hypervolume": 20}
 """The GAs' patience by convergence measure, when ``patience`` is not given (measured: see plan_ga)."""
+
+PAPER_MAX_LENGTH = 100
+"""htetro-ga-paper's l_p,max: Cheng et al. 2020, §V-B3, "l_p,max = 200 is chosen for spiral obstacle
+environment, and l_p,max = 100 is selected for other environments" (a study gives the spiral its 200)."""
+
+PAPER_PATIENCE = 10
+"""htetro-ga-paper's patience, our reading: the paper stops on "the convergence of the solution" (§IV-A)
+without saying when a solution has converged. Its Table 4 ends a run 13–42 generations (means per
+row) after the first goal-reaching one, which a patience of more than about 13 generations cannot
+give; 10 is the round number below."""
 
 
 MAX_POPULATION = 100_000
@@ -128,14 +139,15 @@ OPTIONS = (
            default=1000, type=int, metavar="N"),
     Option("patience", integer(1, none=True), "stop a leg after this many generations without improvement once "
            "its goal is reached", type=int, metavar="N",
-           default_text=", ".join(f"{n} with --converge {m}" for m, n in GA_PATIENCE.items())),
+           default_text=", ".join(f"{n} with --converge {m}" for m, n in GA_PATIENCE.items())
+           + f"; htetro-ga-paper {PAPER_PATIENCE}"),
     Option("convergence", choice(CONVERGENCE_MEASURES), "what counts as an improvement for --patience: best, a "
            "rise of the goal-reaching members' best f_t, f_sm, f_sf or fitness sum; hypervolume, of the best f_t "
            "or of their front's hypervolume (half the generations, a slightly smaller front)", default="best",
            flag="--converge", choices=CONVERGENCE_MEASURES),
     Option("max_length", integer(1, none=True), "l_p,max, the initial chromosome length", type=int, metavar="L",
            default_text="per leg, the least multiple of 100 whose time is at least 1.5 times the leg's exact "
-           "minimum time, as the paper's 100 and 200 on its maps"),
+           f"minimum time, as the paper's 100 and 200 on its maps (ours); htetro-ga-paper {PAPER_MAX_LENGTH}"),
     seed_option(),
     Option("additions", _additions, "the additions of ours switched on: all, none, or some of the hTetro-GA's "
            f"{', '.join(GA_ADDITIONS)} (docs/papers/cheng2020.md) or of the heat planner's "
@@ -146,7 +158,7 @@ OPTIONS = (
     Option("replan_members", integer(0), "random goal-reaching members re-planned each generation besides the "
            "fastest", default=3, type=int, metavar="K"),
     Option("reach_share", real(0.0, 1.0, above=True), "cap on the goal-reaching section of the hTetro-GA's sort, a "
-           "share in (0, 1] of n_pop (ours; 1: the paper's sort)", default=1.0, type=float, metavar="S"),
+           "share in (0, 1] of n_pop (ours, not in htetro-ga-paper; 1: no cap)", default=1.0, type=float, metavar="S"),
     Option("reach_patience", integer(0), "reach repair (ours): when no member has reached the goal and the best "
            "goal reachability has not risen for N generations, the member nearest to the goal gets the "
            "minimum-time path to it; 0 off", default=100, type=int, metavar="N"),
@@ -156,8 +168,8 @@ OPTIONS = (
     Option("conservative", check_bool, "add the hTetro-GA's conservative offspring set (removal, rearrangement, "
            "shortcut of every member) to the algorithm's mating, so that a swap compares algorithms, not operator "
            "sets", default=False, type=bool),
-    Option("seed_exact", check_bool, "put each leg's exact minimum-time plan into its initial population; the "
-           "JSON then reports the gaps to the exact optimum", default=False, type=bool),
+    Option("seed_exact", check_bool, "put each leg's exact minimum-time plan into its initial population (ours, "
+           "not in htetro-ga-paper); the JSON then reports the gaps to the exact optimum", default=False, type=bool),
     Option("pick", choice(tuple(PICKS)), "the solution each leg returns: balanced, the largest sum of the four "
            "fitnesses (the paper's multi-objective solution), or the best f_t, f_sm or f_sf", default="balanced",
            choices=tuple(PICKS)),
@@ -195,11 +207,16 @@ _SIMULATOR = ("clearance", "commands", "timing")
 _GA = (*_SIMULATOR, "pop_size", "max_gen", "patience", "convergence", "max_length", "seed", "replan_window",
        "replan_members", "seed_exact", "pick", "sampling_weights", "verbose", "hv_reference", "progress", "time_limit")
 _HTETRO_GA = (*_GA, "additions", "reach_share", "reach_patience", "polish_window")
+# The paper mode refuses our two options that are not additions (an exact plan in the initial population, a cap
+# on the goal-reaching section): both change the paper's algorithm, and neither is on in htetro-ga by default.
+_HTETRO_GA_PAPER = tuple(name for name in _HTETRO_GA if name not in ("seed_exact", "reach_share"))
 _PYMOO = (*_GA, "conservative")
 _GA_KIND = dict(seeded=True, family=("ga",), capabilities={"progress"}, problem={"diagonals": False},
                 paper="Cheng et al. 2020")
 _OURS = {"additions": tuple(GA_ADDITIONS)}
-_OFF = {"additions": ()}  # the paper's: none of ours (their parameters keep their defaults, for a switch back on)
+# The paper's: none of ours (their parameters keep their defaults, for a switch back on), the paper's l_p,max
+# (§V-B3: 100, 200 on its spiral map) and our reading of its "convergence of the solution" (see PAPER_PATIENCE).
+_OFF = {"additions": (), "patience": PAPER_PATIENCE, "max_length": PAPER_MAX_LENGTH}
 _PARAMETERS = {"replanning": "replan_window", "reach-repair": "reach_patience", "polish": "polish_window"}
 _HEAT_PARAMETERS = {"band": "band", "converge": "engine"}  # a band radius; engine: the converged search's
 _HEAT = (*_SIMULATOR, "weights", "t_max", "additions", "keep_fields")
@@ -248,7 +265,7 @@ METHODS = (
     Method("htetro-ga", "._ga:plan_ga", "Cheng et al. 2020's multi-objective GA over command chromosomes, with our "
            "additions", _HTETRO_GA, defaults=_OURS, presets={"algorithm": "htetro-ga"}, origin="ours",
            **{**_GA_KIND, "family": ("ga", "htetro-ga")}),
-    Method("htetro-ga-paper", "._ga:plan_ga", "the same GA as published", _HTETRO_GA, defaults=_OFF,
+    Method("htetro-ga-paper", "._ga:plan_ga", "the same GA as published", _HTETRO_GA_PAPER, defaults=_OFF,
            presets={"algorithm": "htetro-ga-paper"}, origin="paper", **{**_GA_KIND, "family": ("ga", "htetro-ga")}),
     _pymoo("nsga2", "NSGA-II"),
     _pymoo("nsga3", "NSGA-III"),
