@@ -15,6 +15,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
 
+from htetro_opt._interrupt import removed_on_exit
 from htetro_opt.errors import OutputError
 
 __all__ = ["atomic_path", "check_output_path", "write_text"]
@@ -85,9 +86,10 @@ def atomic_path(path: str | os.PathLike, *, what: str = "output") -> Iterator[Pa
         raise OutputError(f"cannot write {what} {str(path)!r}: {_reason(err)}") from err
     os.close(handle)
     try:
-        os.chmod(tmp, 0o666 & ~_umask())
-        yield Path(tmp)
-        os.replace(tmp, path)
+        with removed_on_exit(tmp):  # also when a signal's helper thread ends the process (htetro_opt._interrupt)
+            os.chmod(tmp, 0o666 & ~_umask())
+            yield Path(tmp)
+            os.replace(tmp, path)
     except OSError as err:
         raise OutputError(f"cannot write {what} {str(path)!r}: {_reason(err)}") from err
     finally:

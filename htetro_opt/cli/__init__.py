@@ -5,10 +5,11 @@ scenario TOML file; ``sequence`` also takes a labelled tileset (a bundled name, 
 scenarios`` lists them too, or a file) or a TSPLIB file. A command's ``--method`` choices, its options'
 flags, defaults and help, and the "this flag does not apply to that method" errors come from its task's
 spec (:mod:`htetro_opt._spec`); nothing here restates them. Errors print one ``error: …`` line and exit
-with status 2; Ctrl-C exits with 130 and SIGTERM with 143, one line each.
+with status 2; Ctrl-C exits with 130 and SIGTERM with 143, one line each (:mod:`htetro_opt._interrupt`).
 
-This module imports only the standard library, so that the signal handlers are in place before
-anything heavy is imported; the commands import their solvers when they run.
+The console script is :func:`htetro_opt.cli._entry.main`, which installs the signal handling before it
+imports this module; this module imports only the standard library, and the commands import their
+solvers when they run.
 """
 
 from __future__ import annotations
@@ -18,6 +19,8 @@ import os
 import signal
 import sys
 from typing import Sequence
+
+from htetro_opt._interrupt import EXITS, Terminated, exit_now, install, installed, received, say
 
 __all__ = ["main", "main_entry", "build_parser"]
 
@@ -47,10 +50,6 @@ def build_parser():
     return parser
 
 
-class Terminated(BaseException):
-    """SIGTERM, turned into an exception so that ``finally`` blocks (temporary files) run."""
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the exit status (0 success, 2 error, 130 interrupted, 143 terminated)."""
     args = None
@@ -69,6 +68,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return EXIT_ERROR
             out = import_module(f"htetro_opt.cli.{args.command}").run(args)
         except (UsageError, HtetroError) as err:
+            if received() is not None:  # a signal turned into an error on its way (a solver's wrapper)
+                raise
             print("error: " + " ".join(str(err).split()), file=sys.stderr)
             return EXIT_ERROR
         except LateOutputError as late:  # the work is done: its result is not thrown away with the file
@@ -77,31 +78,42 @@ def main(argv: Sequence[str] | None = None) -> int:
             print("error: " + " ".join(str(late.error).split()), file=sys.stderr)
             return EXIT_ERROR
     except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
+        say("interrupted")
         return EXIT_INTERRUPTED
     except Terminated:
-        print("terminated", file=sys.stderr)
+        say("terminated")
         return EXIT_TERMINATED
     except SystemExit as done:  # --help and --version
         return int(done.code or 0)
+    except Exception:
+        # After a signal, whatever reaches here is its doing: a native module whose import it broke
+        # (pybind11 turns the KeyboardInterrupt into "ImportError: initialization failed"), a library that
+        # wrapped it. The signal's line and status, not a traceback.
+        signum = received()
+        if signum is None:
+            raise
+        code, word = EXITS[signum]
+        say(word)
+        return code
     if getattr(args, "json", False):
         print(json.dumps(out))
     return 0
 
 
-def _terminate(signum, frame) -> None:
-    raise Terminated()
-
-
 def main_entry() -> None:
-    """Console-script entry point: SIGTERM ends the command like Ctrl-C, one line and no traceback."""
-    signal.signal(signal.SIGTERM, _terminate)
+    """Run the command line as a program: SIGINT and SIGTERM end it with one line and 130 or 143, without a
+    traceback and without the interpreter's teardown (:mod:`htetro_opt._interrupt`; installed here too when
+    the console script, :mod:`htetro_opt.cli._entry`, has not already)."""
+    install()
     try:
         code = main()
         sys.stdout.flush()
     except BrokenPipeError:  # output piped into e.g. `head`, which closed it: not an error of ours
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         code = 1
-    except KeyboardInterrupt:  # a second Ctrl-C while the first was being handled
-        code = EXIT_INTERRUPTED
+    except (KeyboardInterrupt, Terminated) as signalled:  # raised after main's own handlers (printing its output)
+        code, word = EXITS[signal.SIGINT if isinstance(signalled, KeyboardInterrupt) else signal.SIGTERM]
+        say(word)
+    if code in (EXIT_INTERRUPTED, EXIT_TERMINATED) and installed():
+        exit_now(code)  # the finally blocks have run: skip the teardown, seconds on a busy machine
     sys.exit(code)

@@ -1,5 +1,5 @@
 """``python -m htetro_opt.cli``: the same as the ``htetro-opt`` command."""
 
-from htetro_opt.cli import main_entry
+from htetro_opt.cli._entry import main
 
-main_entry()
+main()

@@ -57,6 +57,7 @@ import time
 
 import numpy as np
 
+from htetro_opt._interrupt import kernel_flag
 from htetro_opt._jit import require_numba
 from htetro_opt._validation import as_rng, check_int, check_time_limit
 from htetro_opt.errors import ParameterError
@@ -213,9 +214,10 @@ def _d_compiled(cm, a, b):
 
 @_jit
 def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count, eps, opt2, lengths, full,
-                  budget):
+                  budget, halt):
     """Improve the tour from the queued nodes until the queue is empty or ``budget`` moves are made:
-    (gain, head, moves logged, moves made).
+    (gain, head, moves logged, moves made). Stops early when ``halt[0]`` is set (a signal, see
+    :func:`htetro_opt._interrupt.kernel_flag`; the caller's result is then thrown away).
 
     ``opt2``: try 2-opt moves; ``lengths``: the Or-opt segment lengths, ascending (empty: no Or-opt).
     Restricted (``full`` False, the ILS): a node's candidates are its neighbour list ``nbr`` (legs
@@ -228,6 +230,8 @@ def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count,
     gain_total = 0.0
     moves = 0
     while size > 0 and moves < budget:
+        if halt[0]:  # one byte read a node: nothing next to the node's scan of its candidates
+            break
         a = queue[head]
         head = (head + 1) % n
         size -= 1
@@ -367,7 +371,7 @@ def _neighbour_costs(cm, nbr):
 
 
 @_jit
-def _descend(cm, nbr, nc, tour, opt2, lengths, full, eps, budget):
+def _descend(cm, nbr, nc, tour, opt2, lengths, full, eps, budget, halt):
     """One pass of the local search (:func:`_local_search`) from every node of the tour, in place, until
     no queued node has an improving move or ``budget`` moves are made: the moves made."""
     n = tour.shape[0]
@@ -381,14 +385,14 @@ def _descend(cm, nbr, nc, tour, opt2, lengths, full, eps, budget):
         size = _push(queue, queued, 0, size, tour[i])
     log = np.empty((0, 4), dtype=np.int64)  # nothing is undone: no move is logged
     _, _, _, moves = _local_search(cm, nbr, nc, tour, pos, queue, queued, 0, size, log, 0, eps, opt2, lengths,
-                                   full, budget)
+                                   full, budget, halt)
     return moves
 
 
 @_jit
-def _ils(cm, nbr, tour, kicks, span, seed, eps):
+def _ils(cm, nbr, tour, kicks, span, seed, eps, halt):
     """Local search, then ``kicks`` kicks (double bridges); the tour in place. Returns (kicks done,
-    kicks that lowered the cost)."""
+    kicks that lowered the cost). Stops early when ``halt[0]`` is set (see :func:`_local_search`)."""
     n = tour.shape[0]
     pos = np.empty(n, dtype=np.int64)
     for i in range(n):
@@ -405,7 +409,7 @@ def _ils(cm, nbr, tour, kicks, span, seed, eps):
     for i in range(n):
         size = _push(queue, queued, head, size, tour[i])
     _, head, _, _ = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, 0, eps, True, lengths,
-                                  False, _UNLIMITED)
+                                  False, _UNLIMITED, halt)
     size = 0
     kept = 0
     done = 0
@@ -413,6 +417,8 @@ def _ils(cm, nbr, tour, kicks, span, seed, eps):
         return done, kept
     span = min(span, (n - 2) // 3)
     for _ in range(kicks):
+        if halt[0]:
+            break
         done += 1
         # A B C D → A C B D with |B|, |C|, |D-gap| in 1…span: cut after p1, p2, p3 (positions)
         start = _below(state, n)
@@ -436,7 +442,7 @@ def _ils(cm, nbr, tour, kicks, span, seed, eps):
         for node in (a1, b1, b2, c1, c2, d1):
             size = _push(queue, queued, head, size, node)
         gain, head, count, _ = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count, eps,
-                                             True, lengths, False, _UNLIMITED)
+                                             True, lengths, False, _UNLIMITED, halt)
         size = 0
         if delta - gain <= eps and count <= log.shape[0]:
             if delta - gain < -eps:
@@ -690,9 +696,10 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     # chunks of kicks, each with its own stream draw, so that the cap can stop between them
     chunk = max(1000, kicks // 64)
     first = True
+    halt = kernel_flag()  # set by SIGINT / SIGTERM under the command line: the kernel returns within moments
     while first or done < kicks:
         step = min(chunk, kicks - done)
-        d, k = _ils(cm, nbr, tour, step, ILS_KICK_SPAN, np.uint64((stream + 0x9E37 * done) % 2**64), eps)
+        d, k = _ils(cm, nbr, tour, step, ILS_KICK_SPAN, np.uint64((stream + 0x9E37 * done) % 2**64), eps, halt)
         first = False
         done += d
         kept += k
@@ -765,7 +772,7 @@ class LocalCore:
             return order
         tour = order if self.dummy is None else np.append(order, self.dummy)
         tour = np.ascontiguousarray(tour, dtype=np.int64)
-        _ils(self.cm, self.nbr, tour, int(kicks), ILS_KICK_SPAN, np.uint64(seed % 2**64), self.eps)
+        _ils(self.cm, self.nbr, tour, int(kicks), ILS_KICK_SPAN, np.uint64(seed % 2**64), self.eps, kernel_flag())
         return _decode(tour, self.dummy, self.instance)
 
     def descend(self, order, *, two_opt: bool = True, lengths=(1, 2, 3), certify: bool = True,
@@ -808,11 +815,12 @@ class LocalCore:
         tour = np.ascontiguousarray(tour, dtype=np.int64)
         lengths = np.array(sorted({int(L) for L in lengths}), dtype=np.int64)
         two_opt = bool(two_opt)
+        halt = kernel_flag()
         while True:
-            budget -= _descend(self.cm, self.nbr, self.nc, tour, two_opt, lengths, False, self.eps, budget)
+            budget -= _descend(self.cm, self.nbr, self.nc, tour, two_opt, lengths, False, self.eps, budget, halt)
             if not certify or budget <= 0 or time.perf_counter() >= deadline:
                 break
-            made = _descend(self.cm, self.nbr, self.nc, tour, two_opt, lengths, True, self.eps, budget)
+            made = _descend(self.cm, self.nbr, self.nc, tour, two_opt, lengths, True, self.eps, budget, halt)
             budget -= made
             if made == 0 or budget <= 0 or time.perf_counter() >= deadline:
                 break

@@ -200,6 +200,7 @@ def _sweep_tiling(occ, patterns, seed, deadline):
     stuck one stays covered, so the sweep only moves forward. A failed repair proves nothing (the
     tiles outside the box could lie otherwise).
     """
+    from htetro_opt._interrupt import kernel_flag
     from htetro_opt.solvers.tiling._sweep import dead_cells, sweep  # numba, imported only when needed
 
     h, w = occ.shape
@@ -274,8 +275,9 @@ def _sweep_tiling(occ, patterns, seed, deadline):
     last = max(0, h - _SWEEP_FINAL)  # first row (y counted from the top) left to the final cover
     stop = (_PAD + last) * stride
     at = 0
+    halt = kernel_flag()  # a signal under the command line: the sweep returns at once
     while True:
-        anchors, kinds, at = sweep(filled, offsets, stride, _SWEEP_POCKET, at, stop)
+        anchors, kinds, at = sweep(filled, offsets, stride, _SWEEP_POCKET, at, stop, halt)
         for anchor, k in zip(anchors.tolist(), kinds.tolist()):
             owner[anchor + offsets[k]] = len(tiles)
             tiles.append(anchor + offsets[k])

@@ -112,11 +112,13 @@ def _looks_ahead(filled, at, cells, k, stride, pocket, stamp, seen, stack):
 
 
 @_jit
-def sweep(filled, cells, stride, pocket, at, stop):
+def sweep(filled, cells, stride, pocket, at, stop, halt):
     """Sweep from flat index ``at`` until every cell before ``stop`` is covered or the sweep is stuck.
 
     ``filled`` (uint8, the padded grid, 1 = obstacle or covered) is updated in place. Returns the
-    placed tiles' anchors and pattern indices and the anchor it is stuck at (-1: done).
+    placed tiles' anchors and pattern indices and the anchor it is stuck at (-1: done). When
+    ``halt[0]`` is set (a signal: :func:`htetro_opt._interrupt.kernel_flag`) it returns before its next
+    tile, as if stuck where it is; the caller, back in Python, raises the signal's exception.
     """
     size = filled.size
     anchors = np.empty(size // 4 + 1, dtype=np.int64)
@@ -126,6 +128,8 @@ def sweep(filled, cells, stride, pocket, at, stop):
     stack = np.empty(size, dtype=np.int64)
     n_tiles = 0
     while True:
+        if halt[0]:  # one byte read a tile
+            return anchors[:n_tiles].copy(), kinds[:n_tiles].copy(), at
         while at < stop and filled[at]:
             at += 1
         if at >= stop:
