@@ -104,8 +104,8 @@ def main_entry() -> None:
     """Run the command line as a program: SIGINT and SIGTERM end it with one line and 130 or 143, without a
     traceback and without the interpreter's teardown (:mod:`htetro_opt._interrupt`; installed here too when
     the console script, :mod:`htetro_opt.cli._entry`, has not already)."""
-    install()
     try:
+        install()
         code = main()
         sys.stdout.flush()
     except BrokenPipeError:  # output piped into e.g. `head`, which closed it: not an error of ours
@@ -114,6 +114,10 @@ def main_entry() -> None:
     except (KeyboardInterrupt, Terminated) as signalled:  # raised after main's own handlers (printing its output)
         code, word = EXITS[signal.SIGINT if isinstance(signalled, KeyboardInterrupt) else signal.SIGTERM]
         say(word)
-    if code in (EXIT_INTERRUPTED, EXIT_TERMINATED) and installed():
-        exit_now(code)  # the finally blocks have run: skip the teardown, seconds on a busy machine
+    if installed():
+        if code in (EXIT_INTERRUPTED, EXIT_TERMINATED):
+            exit_now(code)  # the finally blocks have run: skip the teardown, seconds on a busy machine
+        for signum in (signal.SIGINT, signal.SIGTERM):  # the work and its output are done: a signal in the
+            if signal.getsignal(signum) != signal.SIG_IGN:  # teardown ends it plainly, no exception raised
+                signal.signal(signum, signal.SIG_DFL)  # in the middle of the interpreter's finalisation
     sys.exit(code)

@@ -14,9 +14,15 @@ __all__ = ["main"]
 def main() -> None:
     """Install the process-wide signal handling (:func:`htetro_opt._interrupt.install`), then run the
     command line (:func:`htetro_opt.cli.main_entry`)."""
-    from htetro_opt._interrupt import install
+    import signal
 
-    install()
-    from htetro_opt.cli import main_entry
+    from htetro_opt._interrupt import EXITS, Terminated, exit_now, install, say
 
+    try:
+        install()
+        from htetro_opt.cli import main_entry
+    except (KeyboardInterrupt, Terminated) as signalled:  # while the handling or the command line loads
+        code, word = EXITS[signal.SIGINT if isinstance(signalled, KeyboardInterrupt) else signal.SIGTERM]
+        say(word)
+        exit_now(code)
     main_entry()
