@@ -36,7 +36,7 @@ from contextlib import contextmanager
 from typing import Callable, Iterator
 
 __all__ = ["EXITS", "GRACE", "Terminated", "exit_now", "install", "installed", "kernel_flag", "on_signal",
-           "received", "removed_on_exit", "say"]
+           "received", "release", "removed_on_exit", "say"]
 
 _SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
@@ -90,6 +90,15 @@ def install() -> None:
     reader, writer = _wakeup_pair()
     signal.set_wakeup_fd(writer, warn_on_full_buffer=False)
     threading.Thread(target=_watch, args=(reader, watched), name="htetro-signal-exit", daemon=True).start()
+
+
+def release() -> None:
+    """Forget :func:`install` in this process: a study's worker forked from the command line, whose own
+    signals are its parent's business (:func:`htetro_opt.studies._execution._die_with`)."""
+    global _installed
+    _installed = False
+    if threading.current_thread() is threading.main_thread():
+        signal.set_wakeup_fd(-1)
 
 
 def _wakeup_pair() -> tuple[Callable[[], bytes], int]:

@@ -110,6 +110,17 @@ def _running(pid: int) -> bool:
     return bool(state) and not state.startswith(("Z", "X"))
 
 
+def _main_thread_asleep(pid: int) -> bool:
+    """Whether the main thread of ``pid`` is in a sleep system call: its ``wchan``, or where the kernel hides
+    that, its system call's number (clock_nanosleep: 230 on x86-64, 115 on arm64)."""
+    try:
+        if "nanosleep" in Path(f"/proc/{pid}/wchan").read_text():
+            return True
+        return Path(f"/proc/{pid}/syscall").read_text().split()[0] in {"230", "115"}
+    except (OSError, IndexError):
+        return False
+
+
 def _children(pid: int) -> list[int]:
     """The processes whose parent is ``pid`` (from /proc: no psutil)."""
     out = []
@@ -236,9 +247,11 @@ def test_a_main_thread_stuck_in_c_is_ended_by_the_helper_thread(tmp_path):
     proc = subprocess.Popen([sys.executable, "-c", code, str(partial)], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     assert proc.stdout.readline() == "ready\n"
+    # only once the main thread sleeps (else it would run the handler at its next bytecode, the usual path)
+    _wait_for(lambda: _main_thread_asleep(proc.pid), "the main thread to sleep")
     proc.send_signal(signal.SIGTERM)
     _, err = proc.communicate(timeout=60)
-    assert proc.returncode == 143 and err.splitlines() == ["terminated"]
+    assert proc.returncode == 143 and err.splitlines() == ["terminated"], err
     assert not partial.exists()
 
 
