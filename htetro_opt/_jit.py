@@ -113,8 +113,10 @@ def lazy_jit(function=None, *, calls: tuple[str, ...] = ()):
     def call(*args):
         nonlocal compiled
         if compiled is None:
+            dispatcher = require_numba().core.registry.CPUDispatcher
             for name in calls:
-                function.__globals__[name] = _njit(function.__globals__[name])
+                if not isinstance(function.__globals__[name], dispatcher):  # shared by two kernels: compiled once
+                    function.__globals__[name] = _njit(function.__globals__[name])
             compiled = _njit(function)
             announce_compile(compiled)
         return compiled(*args)

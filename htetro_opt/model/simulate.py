@@ -19,6 +19,8 @@ times t and t + 1.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import math
 import os
 import reprlib
@@ -45,7 +47,7 @@ from htetro_opt.model.sweeps import SweepTables, sweep_tables
 from htetro_opt.model.workspace import Workspace, check_workspace, describe_cells
 
 __all__ = ["Simulator", "SimulationResult", "simulate", "MEMORY_BUDGET", "memory_budget", "table_shape",
-           "compile_bytes", "cells_within", "map_text", "size_text", "check_memory", "transitions_at"]
+           "compile_bytes", "cells_within", "map_text", "size_text", "check_memory", "transitions_at", "budget_of"]
 
 _STOP = command_id("stop")
 
@@ -160,18 +162,40 @@ def _walk(keys, steps, lengths, flat, table, n_commands, dead_key, blocked, offs
 
 
 _BUDGET_TEXT = "the smaller of htetro_opt.model.simulate.MEMORY_BUDGET and half the physical memory"
+_GIVEN = contextvars.ContextVar("memory_budget", default=None)  # (bytes, where it was set) within budget_of
+
+
+@contextlib.contextmanager
+def budget_of(nbytes: int | None, source: str = "the memory_budget given"):
+    """Within the block, :func:`memory_budget` is ``nbytes`` (None: the default), and refusals say it
+    was set by ``source`` (e.g. a method's ``memory_budget`` option, the command line's ``--memory-budget``).
+
+    Examples
+    --------
+    >>> with budget_of(2**30):
+    ...     memory_budget()
+    1073741824
+    """
+    token = _GIVEN.set(None if nbytes is None else (int(nbytes), source))
+    try:
+        yield
+    finally:
+        _GIVEN.reset(token)
 
 
 def memory_budget() -> int:
     """Bytes the tables of one simulator (and a search over them) may take: :data:`MEMORY_BUDGET`,
     or half the physical memory where that is less (``os.sysconf``; where it is unknown, the
-    constant alone).
+    constant alone); within :func:`budget_of`, the budget given there.
 
     Examples
     --------
     >>> 0 < memory_budget() <= MEMORY_BUDGET
     True
     """
+    given = _GIVEN.get()
+    if given is not None:
+        return given[0]
     try:
         physical = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
     except (AttributeError, ValueError, OSError):  # not a POSIX system, or the names are unknown
@@ -314,8 +338,9 @@ def check_memory(needed: int, what: str, advice: str) -> None:
     """
     budget = memory_budget()
     if needed > budget:
+        given = _GIVEN.get()
         raise PlanningError(f"{what} would need about {size_text(needed)} of memory, more than the budget of "
-                            f"{size_text(budget)} ({_BUDGET_TEXT}): {advice}")
+                            f"{size_text(budget)} ({_BUDGET_TEXT if given is None else given[1]}): {advice}")
 
 
 def size_text(n: int) -> str:

@@ -1,25 +1,33 @@
 """Exact minimum-time planning over (x, y, state, heading) — the reference for every heuristic.
 
-The search graph is the :class:`~htetro_opt.model.Simulator`'s own transition table: one node per
-pose, one edge per valid command weighted by its duration, so every plan re-validates in the
-simulator by construction. With moving obstacles the graph is time-expanded over their period
-(node = pose × time modulo the period; the obstacles' time is the number of commands executed, as in
-the simulator), and a command that leaves the pose unchanged (``stop``, a shapeshift to the current
-shape) is a way to wait. A roadmap is planned leg by leg, each leg starting where and when the previous one
-ended (Cheng et al. 2020's configuration loop); each leg is time-optimal.
+Two engines, the same optimum:
 
-Two algorithms give the same optimum: ``"dijkstra"`` (scipy.sparse.csgraph over the whole graph, the
-fastest here) and ``"astar"`` (a heapq A* that expands only what it needs, with the admissible
-heuristic "grid distance of B2's cell to the goal × the cheapest translation time per cell"). When
-moving obstacles have a long common period the whole time-expanded graph would not fit in memory
-(more than :data:`MAX_EXPANDED_NODES` nodes, or more than the memory budget): "dijkstra" then hands
-over to A*, and the plan's ``method`` says so. A leg that is unreachable even without the moving
-obstacles is reported at once.
+- **Static maps** (:mod:`~htetro_opt.solvers.grid_paths._lazy`): no graph is built. A pose's successors
+  are computed when it is expanded, from the simulator's per-(state, heading, command) tables and the
+  map, in a numba loop; costs and back pointers take 4 bytes a pose (10 with non-integer command times),
+  and the queue is a bucket queue (a binary heap when the times are not multiples of one quantum).
+  ``"dijkstra"`` searches with h = 0, ``"astar"`` with the point-robot distance field as an admissible,
+  consistent heuristic (its proof is in :func:`~htetro_opt.solvers.grid_paths._lazy.heuristic_field`).
+  Given a Workspace, the plan is re-validated by replaying it through the simulator's own sweep check
+  at the cells it visits (:func:`~htetro_opt.model.simulate.transitions_at`), so no map-sized table is
+  compiled; given a compiled Simulator, by running it there.
+- **Moving obstacles** (the explicit graph, kept as it was): the search graph is the
+  :class:`~htetro_opt.model.Simulator`'s own transition table, time-expanded over the obstacles' period
+  (node = pose × time modulo the period; the obstacles' time is the number of commands executed, as in
+  the simulator), and a command that leaves the pose unchanged (``stop``, a shapeshift to the current
+  shape) is a way to wait. ``"dijkstra"`` is scipy.sparse.csgraph over the whole graph, ``"astar"`` a
+  heapq A* with the heuristic "grid distance of B2's cell to the goal × the cheapest translation time per
+  cell". When the whole time-expanded graph would not fit in memory (more than :data:`MAX_EXPANDED_NODES`
+  nodes, or more than the memory budget) "dijkstra" hands over to A*, and the plan's ``method`` says so.
+  A leg that is unreachable even without the moving obstacles is reported at once.
 
-Before anything is compiled, the memory the simulator's tables and the search would need is
-estimated; a map that would not fit the budget (:func:`~htetro_opt.model.simulate.memory_budget`)
-is refused with a :class:`~htetro_opt.errors.PlanningError` that says how much it would need and
-what fits.
+A roadmap is planned leg by leg, each leg starting where and when the previous one ended (Cheng et
+al. 2020's configuration loop); each leg is time-optimal.
+
+Before anything map-sized is allocated, the memory the search would need is estimated for the engine
+that runs; a map that would not fit the budget (``memory_budget``, the command line's
+``--memory-budget``; by default :func:`~htetro_opt.model.simulate.memory_budget`) is refused with a
+:class:`~htetro_opt.errors.PlanningError` that says how much it would need, what fits, and the flag.
 """
 
 from __future__ import annotations
@@ -39,6 +47,7 @@ from htetro_opt.model.commands import COMMANDS, Timing
 from htetro_opt.model.robot import Pose
 from htetro_opt.model.simulate import (
     Simulator,
+    budget_of,
     cells_within,
     check_memory,
     compile_bytes,
@@ -46,8 +55,11 @@ from htetro_opt.model.simulate import (
     memory_budget,
     size_text,
     table_shape,
+    transitions_at,
 )
 from htetro_opt.model.workspace import Workspace, grid_distance
+from htetro_opt.solvers.grid_paths._lazy import PoseSpace, lazy_bytes, quantum, search_leg
+from htetro_opt.solvers.grid_paths._spec import check_bytes as parse_bytes
 from htetro_opt.solvers.grid_paths._result import Plan, check_map, check_roadmap, finish_plan, prepare
 
 __all__ = ["plan_exact", "EXACT_METHODS"]
@@ -65,6 +77,23 @@ _MASK_BYTES = 3
 _ASTAR_BYTES = 200
 """Bytes per pose of A*'s heap and dictionaries when it reaches every pose, as it does when the goal
 cannot be reached (measured: 183)."""
+
+
+_RAISE = ("; raise the budget with --memory-budget (library: memory_budget=, e.g. '8GiB'), or use a smaller map or "
+          "coarser cells")
+
+
+def _check_lazy(space: PoseSpace, method: str) -> None:
+    """Refuse, before anything map-sized is allocated, a static map whose search would not fit the budget."""
+    per_cell, q = space.n_sh, quantum(space.durations)
+
+    def need(cells: int) -> int:
+        return lazy_bytes(cells * per_cell, cells, space.durations, q)
+
+    ws = space.workspace
+    check_memory(need(space.n_cells), f"exact planning ({method}) on this {ws.width} x {ws.height} map ({per_cell} "
+                                      f"poses a cell, {space.n_commands} commands)",
+                 f"{method!r} fits {map_text(cells_within(need))} with these commands" + _RAISE)
 
 
 def _search(method: str, n_poses: int, n_commands: int, period: int, tables: int) -> str:
@@ -114,7 +143,7 @@ def _check_memory(workspace: Workspace | Simulator, method: str, commands, diago
         advice += (f"; method='astar' fits this map (about {size_text(astar)})" if astar <= memory_budget()
                    else f"; method='astar' fits {map_text(cells_within(lambda c: need(c, 'astar')))}")
     check_memory(needed, f"exact planning ({search}) on this {ws.width} x {ws.height} map ({per_cell} poses a cell, "
-                         f"{n_commands} commands)", advice + "; or use a smaller map or coarser cells")
+                         f"{n_commands} commands, moving obstacles)", advice + _RAISE)
     return search
 
 
@@ -281,6 +310,7 @@ def plan_exact(
     clearance: float = 0.0,
     method: str = "dijkstra",
     t0: int = 0,
+    memory_budget: int | str | None = None,
 ) -> Plan:
     """Minimum-time plan through a roadmap of configurations.
 
@@ -298,11 +328,14 @@ def plan_exact(
     clearance : float, keyword-only
         δ in cells (MODEL.md §4).
     method : {"dijkstra", "astar"}, keyword-only
-        Both give the optimum; a ``"dijkstra"`` plan whose time-expanded graph would be too large is
-        made by A* (its ``method`` then reads ``"dijkstra (astar)"``).
+        Both give the optimum; with moving obstacles, a ``"dijkstra"`` plan whose time-expanded graph
+        would be too large is made by A* (its ``method`` then reads ``"dijkstra (astar)"``).
     t0 : int, keyword-only
         Commands already executed at the start (the clock of moving obstacles), e.g. to plan one leg
         of a longer roadmap.
+    memory_budget : int or str, optional, keyword-only
+        Most bytes the search may take (``"8GiB"``, ``"512MiB"``, ``2**33``; the command line's
+        ``--memory-budget``); None: :func:`~htetro_opt.model.simulate.memory_budget`.
 
     Returns
     -------
@@ -315,10 +348,9 @@ def plan_exact(
         If the method is unknown, ``t0`` is not a non-negative integer, or an argument has the
         wrong type.
     PlanningError
-        If the roadmap has fewer than two configurations, or the simulator's tables and the search
-        graph would need more memory than the budget
-        (:func:`~htetro_opt.model.simulate.memory_budget`): the message says how much, and which
-        map size, or A*, would fit. Nothing is allocated before this check.
+        If the roadmap has fewer than two configurations, or the search would need more memory than
+        the budget: the message says how much, which map size would fit, and the flag that raises
+        the budget. Nothing map-sized is allocated before this check.
     ConfigurationError
         If the start collides or a configuration is outside the map.
 
@@ -332,8 +364,85 @@ def plan_exact(
     if method not in EXACT_METHODS:
         raise ParameterError(f"unknown exact method {method!r}: expected one of {', '.join(EXACT_METHODS)}")
     t0 = check_int(t0, "t0", minimum=0)
+    budget = parse_bytes(memory_budget, "memory_budget")
     check_map(workspace)
     roadmap = check_roadmap(roadmap)
+    source = "set by memory_budget (--memory-budget)"
+    with budget_of(budget, source):
+        moving = (workspace.workspace if isinstance(workspace, Simulator) else workspace).moving
+        options = dict(diagonals=diagonals, commands=commands, timing=timing, clearance=clearance, method=method,
+                       t0=t0)
+        if moving:
+            return _plan_graph(workspace, roadmap, **options)
+        return _plan_lazy(workspace, roadmap, **options)
+
+
+def _plan_lazy(workspace: Workspace | Simulator, roadmap: list[Pose], *, diagonals: bool, commands, timing,
+               clearance: float, method: str, t0: int) -> Plan:
+    """The graph-free planner of a static map (see the module docstring)."""
+    began = _time.perf_counter()
+    sim = workspace if isinstance(workspace, Simulator) else None
+    if sim is not None:
+        space = PoseSpace(sim.workspace, sim.command_ids, sim.durations, sim.tables)
+    else:
+        space = PoseSpace.build(workspace, commands=commands, diagonals=diagonals, timing=timing, clearance=clearance)
+    _check_lazy(space, method)
+    check = sim.check_pose if sim is not None else space.check_pose
+    ids = [check(roadmap[0], what="start", **({"t": t0} if sim is not None else {}))]
+    for i, pose in enumerate(roadmap[1:], start=1):
+        ids.append(check(pose, what="goal" if i == len(roadmap) - 1 else f"roadmap configuration {i + 1}"))
+    local: list[int] = []
+    leg_ends: list[int] = []
+    failed, expanded = -1, 0
+    for leg, (a, b) in enumerate(zip(ids[:-1], ids[1:])):
+        steps, n = search_leg(space, a, b, astar=method == "astar")
+        expanded += n
+        if steps is None:
+            failed = leg
+            break
+        local.extend(steps)
+        leg_ends.append(len(local))
+    global_ids = space.command_ids[np.array(local, dtype=np.int64)] if local else np.empty(0, dtype=np.int64)
+    info = {"expanded": expanded}
+    if sim is not None:
+        return finish_plan(sim, global_ids, ids[0], t0=t0, method=method, leg_ends=leg_ends, failed_leg=failed,
+                           began=began, info=info)
+    return _finish_replayed(space, np.array(local, dtype=np.int64), ids[0], method=method, leg_ends=leg_ends,
+                            failed_leg=failed, began=began, info=info)
+
+
+def _finish_replayed(space: PoseSpace, local: np.ndarray, start: int, *, method: str, leg_ends, failed_leg: int,
+                     began: float, info: dict) -> Plan:
+    """The :class:`Plan` of local commands from pose id ``start``, re-validated without a map-sized table:
+    each command is looked up in the simulator's sweep check at the cell it starts from
+    (:func:`~htetro_opt.model.simulate.transitions_at`), which must give the next pose of the trace."""
+    trace = [start]
+    for c in local.tolist():  # the trace the search claims: the table's target of each command
+        pose = trace[-1]
+        sh, cell = divmod(pose, space.n_cells)
+        e = sh * space.n_commands + c
+        trace.append(int(space.target_sh[e]) * space.n_cells + cell + int(space.dy[c]) * space.width + int(space.dx[c]))
+    trace = np.array(trace, dtype=np.int64)
+    poses = space.decode(trace)
+    for lo in range(0, len(local), 20_000):  # the looked-up rows take ~3 kB a cell: a slice at a time
+        hi = min(lo + 20_000, len(local))
+        rows = transitions_at(space.workspace, poses[lo:hi, :2], commands=space.command_ids.tolist(),
+                              clearance=space.tables.clearance)
+        k = np.arange(hi - lo)
+        after = rows[k, poses[lo:hi, 2], poses[lo:hi, 3], local[lo:hi]]
+        bad = np.flatnonzero(after != trace[lo + 1 : hi + 1])
+        if len(bad):
+            raise PlanningError(f"internal error: the {method} plan does not re-validate in the simulator "
+                                f"(command {lo + int(bad[0]) + 1} of {len(local)} is invalid)")
+    return Plan(method=method, commands=space.command_ids[local] if len(local) else np.empty(0, dtype=np.int64),
+                reached=failed_leg < 0, time=float(space.durations[local].sum()), poses=poses,
+                leg_ends=tuple(int(e) for e in leg_ends), failed_leg=int(failed_leg),
+                runtime_s=_time.perf_counter() - began, info=info)
+
+
+def _plan_graph(workspace: Workspace | Simulator, roadmap: list[Pose], *, diagonals: bool, commands, timing,
+                clearance: float, method: str, t0: int) -> Plan:
+    """The explicit-graph planner (moving obstacles; also the reference of the tests on static maps)."""
     search = _check_memory(workspace, method, commands, diagonals)
     began = _time.perf_counter()
     sim, roadmap, ids = prepare(workspace, roadmap, t0=t0, commands=commands, diagonals=diagonals,

@@ -6,6 +6,8 @@
 
 from __future__ import annotations
 
+import math
+
 from htetro_opt._spec import (
     Method,
     Option,
@@ -27,7 +29,7 @@ from htetro_opt.algorithms import CONVERGENCE_MEASURES, GA_ADDITIONS, PICKS
 from htetro_opt.errors import ParameterError, PlanningError, ScenarioError
 
 __all__ = ["SPEC", "HEAT_ADDITIONS", "HEAT_ELEMENTS", "HEAT_ENGINES", "BAND_SEEDS", "GA_PATIENCE", "PAPER_MAX_LENGTH",
-           "PAPER_PATIENCE", "TABLE6_WEIGHTS"]
+           "PAPER_PATIENCE", "TABLE6_WEIGHTS", "check_bytes"]
 
 HEAT_ADDITIONS = {
     "pinch-split": "the field's bilinear mesh gives a node where two free cells touch only at a corner one copy "
@@ -94,6 +96,36 @@ def _generations(value: int) -> str:
     return f"generations would take {duration_text(value * 1e-3)} or more a leg at a millisecond each"
 
 
+_UNITS = {"": 1, "b": 1, "kb": 10**3, "mb": 10**6, "gb": 10**9, "tb": 10**12,
+          "kib": 2**10, "mib": 2**20, "gib": 2**30, "tib": 2**40}
+
+
+def check_bytes(value, name):
+    """A memory size in bytes: a positive integer, or a text such as ``"8GiB"``, ``"512 MiB"``, ``"2.5GB"``,
+    ``"1000000"``; None passes (the default budget).
+
+    Examples
+    --------
+    >>> check_bytes("8GiB", "memory_budget"), check_bytes("1.5 kB", "memory_budget"), check_bytes(None, "m")
+    (8589934592, 1500, None)
+    """
+    import re
+
+    if value is None:
+        return None
+    if isinstance(value, str):
+        match = re.fullmatch(r"\s*([0-9]*\.?[0-9]+(?:[eE][+-]?[0-9]+)?)\s*([A-Za-z]*)\s*", value)
+        unit = match and match[2].lower()
+        if not match or unit not in _UNITS:
+            raise ParameterError(f"{name} must be a size in bytes such as 8GiB, 512MiB, 2GB or 1000000, got {value!r}")
+        value = float(match[1]) * _UNITS[unit]
+        if not value.is_integer():
+            value = math.floor(value)
+        value = int(value)
+    value = check_int(value, name, minimum=1)
+    return value
+
+
 def _heat_weights(value, name):
     from htetro_opt.problems.heat_costs import check_heat_weights
 
@@ -132,6 +164,9 @@ OPTIONS = (
     Option("timing", unchecked, "a Timing of the commands' durations", flag="", study=False),
     Option("t0", integer(0), "commands executed before the plan starts (the clock of moving obstacles)", default=0,
            flag="", study=False),
+    Option("memory_budget", check_bytes, "most memory the exact search may take, in bytes or as 8GiB, 512MiB, 2GB; "
+           "a map that needs more is refused before anything is allocated, saying how much it needs",
+           metavar="BYTES", default_text="the smaller of 4 GiB and half the physical memory"),
     # the GAs over command chromosomes (Cheng et al. 2020; pymoo's algorithms on the same problem)
     Option("pop_size", at_most(integer(2), MAX_POPULATION, _population), "population size n_pop", default=50,
            type=int, metavar="N"),
@@ -249,7 +284,8 @@ def _relations(method: Method, given: dict, label) -> None:
 
 
 def _exact(name: str, summary: str) -> Method:
-    return Method(name, "._exact:plan_exact", summary, (*_SIMULATOR, "diagonals", "t0"), presets={"method": name},
+    return Method(name, "._exact:plan_exact", summary, (*_SIMULATOR, "diagonals", "t0", "memory_budget"),
+                  presets={"method": name},
                   exact=True, origin="reference", family=("exact",))
 
 

@@ -95,6 +95,11 @@ def test_unknown_methods_and_options():
 def test_a_method_whose_plan_does_not_revalidate_is_an_internal_error(monkeypatch):
     from htetro_opt.solvers.grid_paths import _exact  # its leg search is replaced by a broken one
 
-    monkeypatch.setattr(_exact, "_dijkstra_leg", lambda graph, a, b, t0: [graph.sim.local[parse_commands("x-")[0]]] * 3)
+    x_minus = int(parse_commands("x-")[0])
+    # the static map's graph-free search, replayed through the simulator's sweep check (given a map) or
+    # run in the simulator (given one)
+    monkeypatch.setattr(_exact, "search_leg", lambda space, a, b, astar: ([space.command_ids.tolist().index(x_minus)] * 3, 0))
     with pytest.raises(PlanningError, match="internal error.*dijkstra.*command 2 of 3"):
         plan_path(OPEN, [START, GOAL])
+    with pytest.raises(PlanningError, match="internal error.*astar.*command 2 of 3"):
+        plan_path(Simulator(OPEN), [START, GOAL], method="astar")

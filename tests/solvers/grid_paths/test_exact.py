@@ -236,22 +236,26 @@ def test_statically_unreachable_leg_is_reported_without_a_time_expanded_search()
 SIMULATE = sys.modules["htetro_opt.model.simulate"]  # the module (htetro_opt.model.simulate is the function)
 
 
-@pytest.mark.parametrize("side", [1000, 5000])
+# A map the graph-free planner fits in the default budget (1000 x 1000: about 0.3 GiB) is refused under a
+# budget given as the option; 5000 x 5000 (about 7 GiB) under the default one.
+@pytest.mark.parametrize(("side", "budget"), [(1000, "128MiB"), (5000, None)])
 @pytest.mark.parametrize("method", ["dijkstra", "astar"])
-def test_a_huge_map_is_refused_at_once_saying_how_much_memory_and_what_fits(monkeypatch, side, method):
+def test_a_huge_map_is_refused_at_once_saying_how_much_memory_and_what_fits(monkeypatch, side, budget, method):
     monkeypatch.setattr(Simulator, "_transition_table", lambda self: pytest.fail("allocated before the check"))
+    monkeypatch.setattr(np, "full", lambda *a, **k: pytest.fail("allocated before the check"))
     huge = Workspace(np.zeros((side, side), dtype=bool))
     began = time.perf_counter()
     with pytest.raises(PlanningError) as info:
-        plan_path(huge, [Pose(1, 1, "O", 0), Pose(side - 3, side - 3, "O", 0)], method=method)
+        plan_path(huge, [Pose(1, 1, "O", 0), Pose(side - 3, side - 3, "O", 0)], method=method, memory_budget=budget)
     assert time.perf_counter() - began < 2.0
     message = str(info.value)
-    needed = float(re.search(r"would need about ([\d.]+) GiB of memory", message)[1])
-    budget = float(re.search(r"more than the budget of ([\d.]+) GiB", message)[1])
-    assert needed > budget > 0 and f"{side} x {side} map" in message
+    needed = _needed_bytes(message)
+    limit = float(re.search(r"more than the budget of ([\d.]+) (MiB|GiB)", message)[1])
+    assert needed > limit > 0 and f"{side} x {side} map" in message
     assert re.search(rf"'{method}' fits a map of at most [\d,]+ cells \(e\.g\. \d+ x \d+\)", message), message
-    if method == "dijkstra":
-        assert "method='astar' fits" in message
+    assert "--memory-budget" in message
+    if budget is not None:
+        assert "set by memory_budget (--memory-budget)" in message and "128.0 MiB" in message
 
 
 def _needed_bytes(message):
@@ -262,11 +266,13 @@ def _needed_bytes(message):
 @pytest.mark.parametrize("method", EXACT_METHODS)
 def test_the_estimate_bounds_the_memory_planning_takes(monkeypatch, method):
     """tracemalloc's peak of a real plan (numpy reports its arrays to it) against the refusal's figure,
-    on A*'s worst case: the goal is walled in, so the search reaches every other pose."""
+    on A*'s worst case: the goal is walled in, so the search reaches every other pose. The room's door is a
+    bent corridor one cell wide: B2's point-robot distance (A*'s heuristic) reaches the goal, no shape does."""
     side = 90 if method == "dijkstra" else 50  # A* under tracemalloc is slow; Dijkstra's fixed costs need room
     occ = np.zeros((side, side), dtype=bool)
-    occ[35:45, 35:45] = True
-    occ[37:43, 37:43] = False  # a room no door leads to
+    occ[33:47, 33:47] = True
+    occ[37:43, 37:43] = False  # a room no robot's door leads to
+    occ[40, 33:36] = occ[41, 35:37] = False  # (33..35, 40) then (35..36, 41): a point passes the bend, no shape
     ws = Workspace(occ)
     roadmap = [Pose(2, 2, "O", 0), Pose(39, 40, "O", 0)]
     plan_exact(Workspace(np.zeros((8, 8), dtype=bool)), [Pose(2, 2, "O", 0), Pose(4, 4, "O", 0)], method=method)
