@@ -22,10 +22,11 @@ BLOCKS = ["stop", "x+", "x-", "y+", "y-", "1l", "1r", "2l", "2r", "3l", "3r", "4
 
 
 def random_case(seed, *, states=7, clearance=0.0):
-    """A random map of 8 to 14 cells a side and two random collision-free poses on it."""
+    """A random map of 8 to 14 cells a side, two corners kept free, and two random collision-free poses on it."""
     rng = np.random.default_rng(seed)
     w, h = (int(v) for v in rng.integers(8, 15, size=2))
     occ = rng.random((h, w)) < rng.uniform(0.05, 0.25)
+    occ[:5, :5] = occ[-5:, -5:] = False  # room for collision-free poses, with a clearance too
     ws = Workspace(occ)
     sim = Simulator(ws, commands=BLOCKS if states > 7 else None, clearance=clearance)
     poses = []
