@@ -122,7 +122,7 @@ def run_one(kind: str, size: str) -> dict:
         dist = dijkstra(graph, directed=False, indices=int(index[sy, sx]))
         done = time.perf_counter()
         return {"kind": kind, "size": size, "cells": width * height, "free": int(free.sum()),
-                "graph_s": built - began, "search_s": done - built, "distance": float(dist[gy, gx]),
+                "graph_s": built - began, "search_s": done - built, "distance": float(dist[gy * width + gx]),
                 "peak": _peak_bytes(), "base": base}
     from htetro_opt.model import Pose, Workspace
     from htetro_opt.solvers.grid_paths import plan_exact
