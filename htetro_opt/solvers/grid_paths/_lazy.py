@@ -151,9 +151,16 @@ class PoseSpace:
     def build(cls, workspace: Workspace, *, commands=None, diagonals: bool = False, timing=None,
               clearance: float = 0.0) -> "PoseSpace":
         """The pose space a :class:`~htetro_opt.model.Simulator` with these options would compile."""
-        from htetro_opt.model.commands import Timing
+        import reprlib
 
+        from htetro_opt.errors import ParameterError
+        from htetro_opt.model.commands import Timing
+        from htetro_opt.model.workspace import check_workspace
+
+        check_workspace(workspace)
         ids = np.array(_resolve_commands(commands, diagonals), dtype=np.int64)
+        if timing is not None and not isinstance(timing, Timing):  # as the Simulator says it
+            raise ParameterError(f"timing must be a Timing or None, got {type(timing).__name__} {reprlib.repr(timing)}")
         timing = timing if timing is not None else Timing()
         return cls(workspace, ids, timing.durations()[ids], sweep_tables(clearance))
 
