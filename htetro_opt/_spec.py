@@ -618,15 +618,17 @@ class TaskSpec:
         names = [n for n in (methods or self.taking(option)) if self.methods[n].takes(option)]
         if opt.default_text is not None and not any(option in self.methods[n].defaults for n in names):
             return opt.default_text
-        values = {n: self.default_of(n, option) for n in names}
-        distinct = list(dict.fromkeys(map(_words, values.values())))
+        # a method's own default in words; the option's text for the methods that keep the option's default
+        words = {n: _words(self.default_of(n, option)) if option in self.methods[n].defaults or opt.default_text is None
+                 else opt.default_text for n in names}
+        distinct = list(dict.fromkeys(words.values()))
         if len(distinct) <= 1:
-            if opt.default_text is not None:
+            if opt.default_text is not None and not distinct:
                 return opt.default_text
             return distinct[0] if distinct else _words(opt.default)
         groups: dict[str, list[str]] = {}
-        for n, v in values.items():
-            groups.setdefault(_words(v), []).append(n)
+        for n, w in words.items():
+            groups.setdefault(w, []).append(n)
         return "; ".join(f"{v} for {self.describe(ns, members=False)}" for v, ns in groups.items())
 
     def help(self, option: str, methods: Iterable[str] | None = None) -> str:

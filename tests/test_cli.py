@@ -113,7 +113,7 @@ def test_plan_json_keys_and_optimal_time(plan_out):
                              "leg_ends", "failed_leg", "runtime_s", "time_limited", "additions", "info"}
     assert plan_out["success"] is plan_out["reached"] is True
     assert plan_out["scenario"] == "room"
-    assert plan_out["method"] == "dijkstra"
+    assert plan_out["method"] == "astar"  # the default exact method
     assert plan_out["reached"] is True
     assert isinstance(plan_out["commands"], list) and all(isinstance(t, str) for t in plan_out["commands"])
     # Lower bound: 7 unit translations (Manhattan distance of B2), one rotation (2.0: the goal heading
@@ -899,9 +899,9 @@ def test_study_file_runs_records_and_summarises(capsys, tmp_path):
     records = [json.loads(line) for line in (out_dir / "tiny.jsonl").read_text().splitlines()]
     # the exact method runs once per map (no seed), the GA once per seed
     assert sorted((r["scenario"], r["method"], r["seed"]) for r in records if r.get("kind") != "reference") == [
-        ("h_shape", "dijkstra", None), ("h_shape", "htetro-ga", 0), ("h_shape", "htetro-ga", 1),
-        ("three_slit", "dijkstra", None), ("three_slit", "htetro-ga", 0), ("three_slit", "htetro-ga", 1)]
-    exact = next(r for r in records if r["scenario"] == "three_slit" and r["method"] == "dijkstra")
+        ("h_shape", "astar", None), ("h_shape", "htetro-ga", 0), ("h_shape", "htetro-ga", 1),
+        ("three_slit", "astar", None), ("three_slit", "htetro-ga", 0), ("three_slit", "htetro-ga", 1)]
+    exact = next(r for r in records if r["scenario"] == "three_slit" and r["method"] == "astar")
     assert exact["time"] == 33.0
     # resuming a finished study runs nothing again and gives the same summary
     again = run_json(capsys, ["study", str(study), "--executor", "serial", "--out", str(out_dir), "--resume",

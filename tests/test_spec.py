@@ -73,12 +73,12 @@ def test_importing_the_command_line_loads_no_solver_library():
     assert out.strip() == "[]"
 
 
-def test_plan_method_exact_on_a_grid_is_dijkstras_optimum(capsys):
+def test_plan_method_exact_on_a_grid_is_the_astar_optimum(capsys):
     from htetro_opt.cli import main
 
     assert main(["plan", "three_slit", "--method", "exact", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert out["method"] == "dijkstra" and out["time"] == 33.0
+    assert out["method"] == "astar" and out["time"] == 33.0
 
 
 def test_a_sequence_study_runs_each_method_once_or_once_per_seed():

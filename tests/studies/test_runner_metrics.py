@@ -226,7 +226,7 @@ def test_ga_metrics_on_an_exact_method_name_the_entry(tmp_path, metric):
                      '[[methods]]\nmethod = "htetro-ga"\n[[methods]]\nmethod = "exact"\n', encoding="utf-8")
     with pytest.raises(StudyError) as err:
         load_study(study)
-    for words in (str(study), "methods[1]", repr(metric), "GA methods (", "dijkstra"):
+    for words in (str(study), "methods[1]", repr(metric), "GA methods (", "astar"):
         assert words in str(err.value)
     with pytest.raises(ParameterError, match=rf"'{metric}' applies to the GA methods \(.*\) only, not to astar"):
         run_trial("plan", "three_slit", "astar", {}, None, metrics=[metric])

@@ -100,6 +100,8 @@ def test_a_method_whose_plan_does_not_revalidate_is_an_internal_error(monkeypatc
     # run in the simulator (given one)
     monkeypatch.setattr(_exact, "search_leg", lambda space, a, b, astar: ([space.command_ids.tolist().index(x_minus)] * 3, 0))
     with pytest.raises(PlanningError, match="internal error.*dijkstra.*command 2 of 3"):
-        plan_path(OPEN, [START, GOAL])
+        plan_path(OPEN, [START, GOAL], method="dijkstra")
+    with pytest.raises(PlanningError, match="internal error.*astar.*command 2 of 3"):
+        plan_path(OPEN, [START, GOAL])  # the default
     with pytest.raises(PlanningError, match="internal error.*astar.*command 2 of 3"):
         plan_path(Simulator(OPEN), [START, GOAL], method="astar")
