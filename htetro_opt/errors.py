@@ -19,6 +19,7 @@ __all__ = [
     "TilesetFormatError",
     "TilingError",
     "TilingTimeLimitError",
+    "TilingWorkLimitError",
     "OutputError",
     "StudyError",
     "WorkerLost",
@@ -84,6 +85,27 @@ class TilingTimeLimitError(TilingError):
         super().__init__(message)
         self.time_limit = time_limit
         self.method = method
+
+
+class TilingWorkLimitError(TilingTimeLimitError):
+    """A work budget (``max_steps``, ``max_deterministic_time``) ran out before a tiling was found or
+    proven impossible: as a :class:`TilingTimeLimitError`, whose subclass it is, the map may still be
+    tileable; unlike the time limit, the budget ends the search at the same point on every machine.
+
+    Attributes
+    ----------
+    budget : str
+        The option that ran out.
+    limit : float
+        Its value.
+    time_limit, method
+        As in :class:`TilingTimeLimitError` (the time limit in force, which did not run out).
+    """
+
+    def __init__(self, message: str, *, budget: str, limit: float, time_limit: float, method: str) -> None:
+        super().__init__(message, time_limit=time_limit, method=method)
+        self.budget = budget
+        self.limit = limit
 
 
 class ParameterError(HtetroError, ValueError):

@@ -33,7 +33,8 @@ def cluttered(seed: int = 0, size: int = 12) -> Workspace:
     return Workspace(occ)
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=40, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 @given(seed=st.integers(0, 2**32 - 1), map_seed=st.integers(0, 20))
 def test_repaired_sequences_are_valid_and_change_only_invalid_commands(seed, map_seed, successors):
     ws = cluttered(map_seed)

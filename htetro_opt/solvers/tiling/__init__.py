@@ -20,6 +20,7 @@ from htetro_opt._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
     "tile_workspace": "._tiling", "enumerate_tilings": "._tiling", "find_tiles": "._tiling",
-    "TILING_METHODS": "._tiling", "TilingTimeLimitError": "._tiling", "DEFAULT_TIME_LIMIT": "._spec",
+    "TILING_METHODS": "._tiling", "TilingTimeLimitError": "._tiling", "TilingWorkLimitError": "._tiling",
+    "DEFAULT_TIME_LIMIT": "._spec",
     "TilingResult": "._tiling", "SPEC": "._spec",
 })

@@ -30,6 +30,15 @@ def _check_clock(deadline) -> None:
         raise _TimeLimit("time limit")
 
 
+class _WorkLimit(_TimeLimit):
+    """A work budget of the caller's (``max_steps``, ``max_deterministic_time``) ran out: handled as the
+    time limit is (no proof, never a reason to try a split), reported with the budget's name."""
+
+    def __init__(self, budget: str) -> None:
+        super().__init__(budget)
+        self.budget = budget
+
+
 class _OutOfWork(Exception):
     """A stage of the ``auto`` portfolio used up its work budget: the next stage takes over."""
 

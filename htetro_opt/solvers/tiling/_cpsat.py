@@ -25,23 +25,33 @@ import numpy as np
 
 from htetro_opt._interrupt import on_signal
 from htetro_opt.errors import TilingError
-from htetro_opt.solvers.tiling._common import _check_clock, _OutOfWork, _pattern_order, _placements, _TimeLimit
+from htetro_opt.solvers.tiling._common import (
+    _check_clock,
+    _OutOfWork,
+    _pattern_order,
+    _placements,
+    _TimeLimit,
+    _WorkLimit,
+)
 
 _BUILD_CHUNK = 1 << 15  # CP-SAT variables or constraints built between two looks (~0.1 s)
 _LOAD_SHARE = 0.25  # CP-SAT's model load, as a share of the model's build time (see _cpsat_covers)
 
 
-def _cpsat_tilings(occ, patterns, seed, deadline, limit):
-    """Up to ``limit`` tilings by CP-SAT; [] when infeasible; _TimeLimit when out of time with none."""
-    return _cpsat_covers(~occ, np.zeros_like(occ), patterns, seed, deadline, limit)
+def _cpsat_tilings(occ, patterns, seed, deadline, limit, budget=None):
+    """Up to ``limit`` tilings by CP-SAT; [] when infeasible; _TimeLimit when out of time with none
+    (_WorkLimit when out of ``budget``, ``[deterministic time left]`` or None)."""
+    return _cpsat_covers(~occ, np.zeros_like(occ), patterns, seed, deadline, limit, budget=budget)
 
 
-def _cpsat_covers(must, may, patterns, seed, deadline, limit, work=None):
+def _cpsat_covers(must, may, patterns, seed, deadline, limit, work=None, budget=None):
     """Up to ``limit`` sets of tiles covering each ``must`` cell exactly once and each ``may`` cell at
     most once (every tile touching a ``must`` cell), by CP-SAT; [] when there is none.
 
     Raises _TimeLimit when the deadline comes first, _OutOfWork when ``work`` (CP-SAT's
-    deterministic seconds, the same on every machine) runs out first. The model's build counts
+    deterministic seconds, the same on every machine) runs out first. ``budget`` is the caller's
+    ``max_deterministic_time``: None, or ``[deterministic time left]``, shared by the calls of one
+    search and charged with what this one spends; _WorkLimit when it runs out. The model's build counts
     against the deadline (on a free 256 × 256 grid, 1.2 million placements, it takes seconds in
     OR-Tools' Python layer), so the clock is read every :data:`_BUILD_CHUNK` variables or constraints
     and CP-SAT gets only what is left.
@@ -100,6 +110,11 @@ def _cpsat_covers(must, may, patterns, seed, deadline, limit, work=None):
     params.linearization_level = 0
     params.symmetry_level = 0
     params.use_sat_inprocessing = False
+    by_budget = budget is not None and (work is None or budget[0] <= work)  # which of the two can stop it
+    if budget is not None:
+        if budget[0] <= 0:
+            raise _WorkLimit("max_deterministic_time")
+        work = budget[0] if by_budget else work
     if work is not None:
         params.max_deterministic_time = work
     if deadline is not None:
@@ -133,6 +148,8 @@ def _cpsat_covers(must, may, patterns, seed, deadline, limit, work=None):
             status = solver.Solve(model)
         if status in (cp_model.OPTIMAL, cp_model.FEASIBLE):
             record(solver.response_proto.solution)
+    if budget is not None:
+        budget[0] -= solver.deterministic_time
     if found:
         return found
     if status == cp_model.INFEASIBLE:
@@ -140,6 +157,8 @@ def _cpsat_covers(must, may, patterns, seed, deadline, limit, work=None):
     if status == cp_model.UNKNOWN:
         if deadline is not None and _time.perf_counter() >= deadline - 1e-3:
             raise _TimeLimit("time limit")
+        if by_budget:
+            raise _WorkLimit("max_deterministic_time")
         if work is not None:
             raise _OutOfWork
         raise _TimeLimit("time limit")  # stopped by a signal handler that did not raise

@@ -33,11 +33,13 @@ is found wrong only rows later. So ``auto`` runs, in turn:
    (the bands above might have been tiled otherwise), and the next stage runs;
 4. CP-SAT on each 4-connected region of free cells on its own, the smallest first (a small region
    that cannot be tiled ends the search at once), until it finds a tiling, proves there is none,
-   or the time limit runs out: then the error says that neither was found.
+   or the time limit (or ``max_deterministic_time``, when given) runs out: then the error says that
+   neither was found.
 
 Several tilings (:func:`~htetro_opt.solvers.tiling.enumerate_tilings`) go from stage 1 to CP-SAT
 on the whole map. Every budget is counted in steps or CP-SAT's deterministic time, not seconds, so
-a map gets the same tiling on every machine; only ``time_limit`` depends on the clock.
+a map gets the same tiling on every machine; only ``time_limit`` depends on the clock (with
+``max_deterministic_time`` bounding the last stage, a call ends the same way on every machine).
 
 The budgets are the private constants below, tuning choices rather than options; the tests set
 some of them on this module to force a stage on small maps.
@@ -324,28 +326,31 @@ def _sweep_tiling(occ, patterns, seed, deadline):
     return _in_scan_order(out)
 
 
-def _component_tilings(occ, patterns, seed, deadline):
+def _component_tilings(occ, patterns, seed, deadline, budget=None):
     """One tiling by CP-SAT, each 4-connected region of free cells on its own (the smallest first,
-    so that a small region that cannot be tiled ends the search at once); [] when one has none."""
+    so that a small region that cannot be tiled ends the search at once); [] when one has none.
+    ``budget``: the caller's ``max_deterministic_time`` left, shared by the regions (or None)."""
     labels, n = ndimage.label(~occ)
     if n == 1:
-        return _cpsat_covers(~occ, np.zeros_like(occ), patterns, seed, deadline, 1)
+        return _cpsat_covers(~occ, np.zeros_like(occ), patterns, seed, deadline, 1, budget=budget)
     sizes = np.bincount(labels.ravel())
     where = ndimage.find_objects(labels)
     tiles: list[np.ndarray] = []
     for i in sorted(range(1, n + 1), key=lambda i: (int(sizes[i]), i)):
         region, origin = _cropped(labels == i, where[i - 1])
-        found = _cpsat_covers(region, np.zeros_like(region), patterns, seed, deadline, 1)
+        found = _cpsat_covers(region, np.zeros_like(region), patterns, seed, deadline, 1, budget=budget)
         if not found:
             return []
         tiles += [t + origin for t in found[0]]
     return [_in_scan_order(tiles)]
 
 
-def _auto_tilings(occ, patterns, seed, deadline, limit):
+def _auto_tilings(occ, patterns, seed, deadline, limit, budget=None):
     """The ``auto`` portfolio: backtracking for :data:`_AUTO_STEPS`; then (one tiling) the repaired
     sweep on a map of :data:`_SWEEP_CELLS` free cells or more, the band stage on a map taller and
-    wider than two bands, and CP-SAT region by region; or (several tilings) CP-SAT on the whole map."""
+    wider than two bands, and CP-SAT region by region; or (several tilings) CP-SAT on the whole map.
+    ``budget``: None, or ``[max_deterministic_time]`` for the last stage, the only one without a
+    budget of its own (with it, no stage depends on the clock but the time limit)."""
     tiles = int((~occ).sum()) // 4
     found = []
     generator = _backtracking_tilings(occ, patterns, seed, deadline, [_AUTO_STEPS[0] + _AUTO_STEPS[1] * tiles])
@@ -360,7 +365,7 @@ def _auto_tilings(occ, patterns, seed, deadline, limit):
     finally:
         generator.close()
     if limit > 1:
-        return _cpsat_tilings(occ, patterns, seed, deadline, limit)
+        return _cpsat_tilings(occ, patterns, seed, deadline, limit, budget)
     if 4 * tiles >= _SWEEP_CELLS:
         swept = _sweep_tiling(occ, patterns, seed, deadline)
         if swept is not None:
@@ -373,4 +378,4 @@ def _auto_tilings(occ, patterns, seed, deadline, limit):
                 return _band_tiling(occ, patterns, seed, deadline, turns)
             except _OutOfWork:  # these bands proved nothing: from the other end, then CP-SAT
                 pass
-    return _component_tilings(occ, patterns, seed, deadline)
+    return _component_tilings(occ, patterns, seed, deadline, budget)

@@ -7,7 +7,7 @@ read (see :mod:`htetro_opt._spec`). Importing it loads no OR-Tools or numba.
 
 from __future__ import annotations
 
-from htetro_opt._spec import Method, Option, Problem, TaskSpec, seed_option, unchecked
+from htetro_opt._spec import Method, Option, Problem, TaskSpec, integer, real, seed_option, unchecked
 from htetro_opt._validation import check_bool, check_time_limit
 from htetro_opt.errors import ParameterError, ScenarioError
 
@@ -45,6 +45,14 @@ OPTIONS = (
     seed_option("with --shuffle: its random seed"),
     Option("time_limit", check_time_limit, "give up after this many seconds", default=DEFAULT_TIME_LIMIT, type=float,
            metavar="S"),
+    # Budgets of work, the same on every machine (the time limit depends on the machine and its load):
+    # with one of them and a time limit that does not run out, a call ends the same way everywhere.
+    Option("max_steps", integer(1, none=True), "give up after this many search steps (placements tried; the "
+           "same on every machine)", type=int, metavar="N", default_text="none, only the time limit"),
+    Option("max_deterministic_time", real(0.0, above=True, none=True), "give up after CP-SAT has spent this much "
+           "of its deterministic time (its own unit, about a second, the same on every machine; auto: on its "
+           "last stage, CP-SAT region by region, the earlier stages having fixed budgets of their own)",
+           type=float, metavar="D", default_text="none, only the time limit"),
     Option("overlap", check_bool, "if the map cannot be tiled, cover it by two overlapping sub-workspaces (the "
            "paper's Fig. 5)", default=False, type=bool),
     Option("weights", _weights, "α, β, λ, γ of eq. 2, for Algorithm 1's choice among a symmetric tile's labellings",
@@ -53,6 +61,8 @@ OPTIONS = (
 )
 
 _OPTIONS = ("shapes", "shuffle", "seed", "time_limit", "overlap", "weights", "name")
+_BUDGETS = {"auto": ("max_deterministic_time",), "backtracking": ("max_steps",), "cpsat": ("max_deterministic_time",)}
+"""The work budget each method takes: the backtracker counts steps, CP-SAT its deterministic time."""
 _PAPER = "Le et al. 2018"
 
 
@@ -62,10 +72,13 @@ def _shuffled(options) -> bool:
 
 METHODS = (
     Method("auto", None, "backtracking for a few steps, then a compiled sweep repaired by small exact covers, then "
-           "CP-SAT band by band, then region by region", _OPTIONS, seeded=_shuffled, exact=True, origin="ours"),
-    Method("backtracking", None, "the paper's search", _OPTIONS, seeded=_shuffled, exact=True, origin="paper",
+           "CP-SAT band by band, then region by region", _OPTIONS + _BUDGETS["auto"], seeded=_shuffled, exact=True,
+           origin="ours"),
+    Method("backtracking", None, "the paper's search", _OPTIONS + _BUDGETS["backtracking"], seeded=_shuffled,
+           exact=True, origin="paper",
            paper=_PAPER),
-    Method("cpsat", None, "exact cover with OR-Tools CP-SAT", _OPTIONS, seeded=_shuffled, exact=True, origin="ours"),
+    Method("cpsat", None, "exact cover with OR-Tools CP-SAT", _OPTIONS + _BUDGETS["cpsat"], seeded=_shuffled,
+           exact=True, origin="ours"),
 )
 
 
@@ -88,4 +101,4 @@ SPEC = TaskSpec(
     methods=METHODS, default="auto", pose=_pose, solve=_solve,
 )
 """The tiling task (see the module docstring). Every method is complete: it tiles the map or proves that
-no tiling exists, within its time limit."""
+no tiling exists, within its time limit (and its work budget, if given)."""

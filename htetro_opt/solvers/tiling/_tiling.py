@@ -47,6 +47,13 @@ Time limit
     :class:`~htetro_opt.errors.TilingError` that says the map may still be tileable; a plain
     TilingError is a proof that it is not.
 
+Work budgets
+    The time limit depends on the machine and its load. A budget of work does not: ``max_steps``
+    (the backtracker's search steps) or ``max_deterministic_time`` (CP-SAT's deterministic time, for
+    ``cpsat`` and for the last stage of ``auto``, whose other stages have fixed budgets). With one
+    and a time limit that does not run out, a call tiles, proves, or gives up at the same point on
+    every machine; running out raises :class:`TilingWorkLimitError`, a TilingTimeLimitError (no proof).
+
 Examples
 --------
 >>> tile_workspace(np.zeros((2, 4), dtype=bool)).tileset.shapes
@@ -72,7 +79,7 @@ from htetro_opt._validation import (
     check_time_limit,
     derive_seed,
 )
-from htetro_opt.errors import ParameterError, ScenarioError, TilingError, TilingTimeLimitError
+from htetro_opt.errors import ParameterError, ScenarioError, TilingError, TilingTimeLimitError, TilingWorkLimitError
 from htetro_opt.model.tiles import Pattern, patterns_of
 from htetro_opt.model.workspace import Workspace
 from htetro_opt.problems.waypoint_sequencing import (
@@ -83,7 +90,7 @@ from htetro_opt.problems.waypoint_sequencing import (
 from htetro_opt.scenarios.tileset import Tileset
 from htetro_opt.solvers._result import Result
 from htetro_opt.solvers.tiling._backtracking import _backtracking_tilings
-from htetro_opt.solvers.tiling._common import _shape_text, _TimeLimit
+from htetro_opt.solvers.tiling._common import _OutOfWork, _shape_text, _TimeLimit, _WorkLimit
 from htetro_opt.solvers.tiling._cpsat import _cpsat_tilings
 from htetro_opt.solvers.tiling._overlap import _overlapping_tiles
 from htetro_opt.solvers.tiling._portfolio import _auto_tilings
@@ -96,6 +103,7 @@ __all__ = [
     "TILING_METHODS",
     "TilingResult",
     "TilingTimeLimitError",
+    "TilingWorkLimitError",
     "enumerate_tilings",
     "find_tiles",
     "tile_workspace",
@@ -194,6 +202,23 @@ def _check_options(shuffle, seed, time_limit) -> tuple[int | None, float, float]
 # Drivers
 
 
+_BUDGET_NAMES = ("max_steps", "max_deterministic_time")
+
+
+def _work_message(method, budget, limit) -> str:
+    if budget == "max_steps":
+        return (f"the backtracking search found no tiling and proved none impossible within max_steps={limit} "
+                "search steps; try the auto or cpsat method or a larger max_steps")
+    return (f"{'CP-SAT' if method == 'cpsat' else 'the auto portfolio'} found no tiling and proved none impossible "
+            f"within max_deterministic_time={limit:g} (CP-SAT's deterministic time); try a larger one")
+
+
+def _budgets(options) -> dict:
+    """The work budgets given among ``options`` (checked by the spec, which refuses one a method does
+    not take): ``{name: [left]}``, shared by every search of the call (the bands of ``overlap`` too)."""
+    return {name: [options[name]] for name in _BUDGET_NAMES if options.get(name) is not None}
+
+
 def _time_message(method, time_limit) -> str:
     if method == "backtracking":
         return (f"the backtracking search found no tiling and proved none impossible within the time limit of "
@@ -205,26 +230,31 @@ def _time_message(method, time_limit) -> str:
             "(building its model included); try a longer time limit")
 
 
-def _tilings(occ, patterns, method, seed, deadline, limit):
-    """Pre-checks, then up to ``limit`` tilings (non-empty list) or TilingError / _TimeLimit."""
+def _tilings(occ, patterns, method, seed, deadline, limit, budgets=None):
+    """Pre-checks, then up to ``limit`` tilings (non-empty list) or TilingError / _TimeLimit
+    (_WorkLimit when one of ``budgets``, from :func:`_budgets`, runs out)."""
     _precheck(occ, patterns)
+    budgets = budgets or {}
     if method == "backtracking":
         found = []
-        generator = _backtracking_tilings(occ, patterns, seed, deadline)
+        generator = _backtracking_tilings(occ, patterns, seed, deadline, budgets.get("max_steps"))
         try:
             for tiles in generator:
                 found.append(tiles)
                 if len(found) >= limit:
                     break
+        except _OutOfWork:
+            if not found:
+                raise _WorkLimit("max_steps") from None
         except _TimeLimit:
             if not found:
                 raise
         finally:
             generator.close()
     elif method == "auto":
-        found = _auto_tilings(occ, patterns, seed, deadline, limit)
+        found = _auto_tilings(occ, patterns, seed, deadline, limit, budgets.get("max_deterministic_time"))
     else:
-        found = _cpsat_tilings(occ, patterns, seed, deadline, limit)
+        found = _cpsat_tilings(occ, patterns, seed, deadline, limit, budgets.get("max_deterministic_time"))
     if not found:
         raise TilingError(
             f"no tiling of the {int((~occ).sum())} free cells by {_shape_text(patterns)} tetrominoes exists "
@@ -233,13 +263,19 @@ def _tilings(occ, patterns, method, seed, deadline, limit):
     return found
 
 
-def _retime(method, time_limit) -> TilingTimeLimitError:
-    """The error the caller sees when the time limit ran out."""
+def _retime(method, time_limit, err=None, options=None) -> TilingTimeLimitError:
+    """The error the caller sees when the time limit ran out, or (``err`` a _WorkLimit) the work budget
+    of ``options`` it names."""
+    if isinstance(err, _WorkLimit):
+        limit = options[err.budget]
+        return TilingWorkLimitError(_work_message(method, err.budget, limit), budget=err.budget, limit=limit,
+                                    time_limit=time_limit, method=method)
     return TilingTimeLimitError(_time_message(method, time_limit), time_limit=time_limit, method=method)
 
 
 def find_tiles(occupancy, *, shapes=None, method: str = "auto", shuffle: bool = False, seed=None,
-               time_limit: float | None = None) -> list[np.ndarray]:
+               time_limit: float | None = None, max_steps: int | None = None,
+               max_deterministic_time: float | None = None) -> list[np.ndarray]:
     """An exact cover of the free cells by tetrominoes of the allowed shapes.
 
     Parameters
@@ -259,6 +295,12 @@ def find_tiles(occupancy, *, shapes=None, method: str = "auto", shuffle: bool = 
     time_limit : float, optional
         Seconds the search may take, model building included; :data:`DEFAULT_TIME_LIMIT` (60 s)
         when None.
+    max_steps : int, optional
+        ``backtracking`` only: search steps (placements tried) before it gives up, the same on every
+        machine. None: only the time limit.
+    max_deterministic_time : float, optional
+        ``cpsat``, and ``auto``'s last stage: CP-SAT's deterministic time (its own unit, about a
+        second, the same on every machine) before it gives up. None: only the time limit.
 
     Returns
     -------
@@ -269,7 +311,8 @@ def find_tiles(occupancy, *, shapes=None, method: str = "auto", shuffle: bool = 
     ------
     TilingTimeLimitError
         If the time limit runs out first: neither a tiling nor a proof that none exists was found
-        (a subclass of TilingError, so catch it first to tell the two apart).
+        (a subclass of TilingError, so catch it first to tell the two apart); its subclass
+        :class:`TilingWorkLimitError` if a work budget runs out first.
     TilingError
         If a pre-check fails (no free cell; free area, or a 4-connected region's area, not a multiple
         of 4; unequal checkerboard colours without T; a cell no allowed tile fits over) or no tiling
@@ -277,7 +320,8 @@ def find_tiles(occupancy, *, shapes=None, method: str = "auto", shuffle: bool = 
     UnknownShapeError
         If a shape name is unknown.
     ParameterError
-        If ``shapes`` is empty, or ``method``, ``seed`` or ``time_limit`` is invalid.
+        If ``shapes`` is empty, or ``method``, ``seed``, ``time_limit`` or a budget is invalid (or a
+        budget the method does not take is given).
 
     Examples
     --------
@@ -288,11 +332,13 @@ def find_tiles(occupancy, *, shapes=None, method: str = "auto", shuffle: bool = 
     occ, _ = _as_occupancy(occupancy, "occupancy")
     patterns = _check_shapes(shapes)
     method = _check_method(method)
+    given = {"max_steps": max_steps, "max_deterministic_time": max_deterministic_time}
+    given = SPEC.check(method, {k: v for k, v in given.items() if v is not None}, fill=False)
     seed, deadline, time_limit = _check_options(shuffle, seed, time_limit)
     try:
-        return _tilings(occ, patterns, method, seed, deadline, 1)[0]
+        return _tilings(occ, patterns, method, seed, deadline, 1, _budgets(given))[0]
     except _TimeLimit as err:
-        raise _retime(method, time_limit) from err
+        raise _retime(method, time_limit, err, given) from err
 
 
 def tile_workspace(workspace, *, method: str = SPEC.default, **options) -> TilingResult:
@@ -314,6 +360,9 @@ def tile_workspace(workspace, *, method: str = SPEC.default, **options) -> Tilin
         shapes, shuffle, seed, time_limit
             As in :func:`find_tiles` (the seed only with ``shuffle``); the time limit covers the whole
             call, splits included (default :data:`DEFAULT_TIME_LIMIT`, 60 s).
+        max_steps, max_deterministic_time
+            As in :func:`find_tiles`, for the methods that take them; a budget covers the whole call,
+            splits included.
         overlap : bool
             When the free cells do not tile as they are, split the grid into two overlapping bands of
             rows (``y < k2`` and ``y >= k1``) or of columns whose free cells both tile, the split with
@@ -348,7 +397,7 @@ def tile_workspace(workspace, *, method: str = SPEC.default, **options) -> Tilin
     occ, cell_size = _as_occupancy(workspace, "workspace")
     if callable(method):
         chosen = Method(getattr(method, "__name__", type(method).__name__), method, "a user's tiler",
-                        tuple(SPEC.options), seeded=True)
+                        tuple(o for o in SPEC.options if o not in _BUDGET_NAMES), seeded=True)
     else:
         chosen = SPEC.method(method)
     options = SPEC.check(chosen, options)
@@ -362,9 +411,10 @@ def tile_workspace(workspace, *, method: str = SPEC.default, **options) -> Tilin
                                           seed=options["seed"], time_limit=time_limit)
         tileset = block_locations(occ, tiles, weights=weights, cell_size=cell_size, name=name)
         return _result(tileset, chosen.name, began)
+    budgets = _budgets(options)
     try:
         try:
-            tiles = _tilings(occ, patterns, chosen.name, seed, deadline, 1)[0]
+            tiles = _tilings(occ, patterns, chosen.name, seed, deadline, 1, budgets)[0]
         except _TimeLimit:
             raise
         except TilingError as err:
@@ -372,11 +422,11 @@ def tile_workspace(workspace, *, method: str = SPEC.default, **options) -> Tilin
                 raise
 
             def tile(band):  # each band by the same method, pre-checks included
-                return _tilings(band, patterns, chosen.name, seed, deadline, 1)[0]
+                return _tilings(band, patterns, chosen.name, seed, deadline, 1, budgets)[0]
 
             tiles = _overlapping_tiles(occ, patterns, deadline, err, tile)
     except _TimeLimit as err:
-        raise _retime(chosen.name, time_limit) from err
+        raise _retime(chosen.name, time_limit, err, options) from err
     return _result(block_locations(occ, tiles, weights=weights, cell_size=cell_size, name=name), chosen.name, began)
 
 
