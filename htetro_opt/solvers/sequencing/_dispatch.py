@@ -231,9 +231,9 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", **options
 
 def _time_limited(info: dict, capabilities) -> bool:
     """Whether the clock, not the method's own end, stopped it: a search that only ends on its time budget
-    (``"timed"``: OR-Tools' guided local search, fast-tsp), generations, kicks or iterations cut short, or an
-    optimality proof not reached in time."""
+    (``"timed"``: OR-Tools' guided local search, fast-tsp, unless it says its solution limit ended it),
+    generations, kicks or iterations cut short, or an optimality proof not reached in time."""
     if "timed" in capabilities:
-        return True
+        return bool(info.get("time_limited", True))
     return bool(info.get("time_limited") or info.get("timed_out") or info.get("stopped") == "time_limit"
                 or info.get("optimal") is False)

@@ -30,7 +30,7 @@ import numpy as np
 
 from htetro_opt._interrupt import on_signal
 from htetro_opt._progress import check_progress, report
-from htetro_opt._validation import check_real, check_seed, check_time_limit
+from htetro_opt._validation import check_int, check_real, check_seed, check_time_limit
 from htetro_opt.errors import ParameterError, PlanningError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance
 from htetro_opt.solvers.sequencing._spec import FIRST_SOLUTIONS
@@ -65,7 +65,7 @@ def ortools_time_limit(n: int) -> float:
 
 def solve_ortools(instance: SequencingInstance, *, seed=0, time_limit: float | None = None,
                   scale: float | None = None, first_solution: str = "PATH_CHEAPEST_ARC",
-                  progress=None) -> tuple[np.ndarray, dict]:
+                  progress=None, solution_limit: int | None = None) -> tuple[np.ndarray, dict]:
     """A near-optimal order of an instance's waypoints by OR-Tools routing with guided local search.
 
     Parameters
@@ -87,19 +87,25 @@ def solve_ortools(instance: SequencingInstance, *, seed=0, time_limit: float | N
     progress : callable, optional
         ``progress(seconds spent, time limit, note)`` at most five times a second, the note giving the
         cost of the solution the search is at.
+    solution_limit : int, optional
+        Stop after this many solutions (the first one and each the local search moves to), whichever of
+        it and the time limit comes first. The search is deterministic, so a run stopped by it gives the
+        same order on every machine. None (default): only the time limit.
 
     Returns
     -------
     order : ndarray of int64, shape (n,)
         Waypoint indices, beginning at ``instance.start`` when it is fixed.
     info : dict
-        ``status`` (OR-Tools' search status), ``time_limit_s`` and ``scale`` used.
+        ``status`` (OR-Tools' search status), ``time_limit_s`` and ``scale`` used, ``solutions``
+        (how many the search went through) and ``time_limited`` (False only when ``solution_limit``
+        stopped it: then the order does not depend on the machine's speed).
 
     Raises
     ------
     ParameterError
         On a bad ``seed``, ``time_limit``, ``scale`` (not positive, or so large that a path's
-        scaled cost could reach 2⁵³) or ``first_solution``.
+        scaled cost could reach 2⁵³), ``first_solution`` or ``solution_limit``.
     PlanningError
         If OR-Tools finds no order within the time limit.
 
@@ -117,6 +123,7 @@ def solve_ortools(instance: SequencingInstance, *, seed=0, time_limit: float | N
     limit = check_time_limit(time_limit)
     limit = ortools_time_limit(n) if limit is None else limit
     progress = check_progress(progress)
+    solution_limit = check_int(solution_limit, "solution_limit", minimum=1, allow_none=True)
     if not isinstance(first_solution, str) or first_solution.upper() not in FIRST_SOLUTIONS:
         raise ParameterError(f"first_solution must be one of {', '.join(FIRST_SOLUTIONS)}; got {first_solution!r}")
     top = float(np.abs(instance.cost).max())
@@ -132,7 +139,8 @@ def solve_ortools(instance: SequencingInstance, *, seed=0, time_limit: float | N
     else:
         factor = scale
     if n == 1:
-        return np.zeros(1, dtype=np.int64), {"status": "TRIVIAL", "time_limit_s": limit, "scale": factor}
+        return np.zeros(1, dtype=np.int64), {"status": "TRIVIAL", "time_limit_s": limit, "scale": factor,
+                                             "solutions": 1, "time_limited": False}
 
     from ortools.constraint_solver import pywrapcp, routing_enums_pb2  # deferred: a slow import
 
@@ -157,11 +165,15 @@ def solve_ortools(instance: SequencingInstance, *, seed=0, time_limit: float | N
     params.local_search_metaheuristic = routing_enums_pb2.LocalSearchMetaheuristic.GUIDED_LOCAL_SEARCH
     began = time.perf_counter()
     params.time_limit.FromMilliseconds(max(1, round(max(limit - (began - entered), 0.1 * limit) * 1000)))
+    if solution_limit is not None:
+        params.solution_limit = solution_limit
     last_report = [began]
+    solutions = [0]
     with on_signal() as interrupted:
         def at_solution() -> None:
             # Guided local search only stops at its time limit: end it at the next solution it visits
             # (measured at most ~0.2 s apart on 1000 waypoints) once Ctrl-C or SIGTERM has arrived.
+            solutions[0] += 1
             if interrupted.is_set():
                 routing.solver().FinishCurrentSearch()
             now = time.perf_counter()
@@ -183,4 +195,6 @@ def solve_ortools(instance: SequencingInstance, *, seed=0, time_limit: float | N
         if node != dummy:
             order.append(node)
         index = solution.Value(routing.NextVar(index))
-    return np.array(order, dtype=np.int64), {"status": status, "time_limit_s": limit, "scale": factor}
+    cut = solution_limit is None or solutions[0] < solution_limit  # the clock, not the solution limit, ended it
+    return np.array(order, dtype=np.int64), {"status": status, "time_limit_s": limit, "scale": factor,
+                                             "solutions": solutions[0], "time_limited": cut}

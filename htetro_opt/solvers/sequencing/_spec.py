@@ -139,6 +139,9 @@ OPTIONS = (
     Option("iterations", integer(1), "random restarts of the greedy search", default=10_000, flag=""),
     Option("scale", real(0.0, above=True, none=True),
            "multiplier turning costs into OR-Tools' integers", flag="", default_text="from the largest cost"),
+    Option("solution_limit", integer(1, none=True), "OR-Tools: stop after this many solutions of its local "
+           "search, so that the order is the same on every machine", type=int, metavar="N",
+           default_text="none, only the time limit"),
     Option("first_solution", choice(FIRST_SOLUTIONS), "OR-Tools' first-solution strategy",
            default="PATH_CHEAPEST_ARC", flag="", choices=FIRST_SOLUTIONS),
     Option("max_size", integer(1), "largest instance the exact solver accepts", default=EXACT_MAX_SIZE, flag=""),
@@ -157,12 +160,13 @@ _PATTERN = dict(capabilities={"asymmetric", "geometry"}, origin="baseline", pape
 METHODS = (
     # auto runs exact, ils or ortools (auto_method): it takes their options and hands each the ones it takes
     Method("auto", None, f"exact up to {EXACT_AUTO_LIMIT} waypoints, ils beyond (ortools for asymmetric costs)",
-           ("seed", "time_limit", "progress", "max_size", "kicks", "neighbours", "scale", "first_solution"),
+           ("seed", "time_limit", "progress", "max_size", "kicks", "neighbours", "scale", "first_solution",
+            "solution_limit"),
            seeded=True, capabilities={"asymmetric", "tours", "implicit"}),
     Method("exact", "._exact:solve_exact", f"the CP-SAT optimum with a proof (<= {EXACT_MAX_SIZE} waypoints)",
            ("time_limit", "max_size"), exact=True, origin="reference", capabilities={"asymmetric"}),
     Method("ortools", "._ortools:solve_ortools", "OR-Tools routing with guided local search (the paper's baseline)",
-           ("time_limit", "progress", "scale", "first_solution"), origin="baseline", paper=_PAPER,
+           ("time_limit", "progress", "scale", "first_solution", "solution_limit"), origin="baseline", paper=_PAPER,
            capabilities={"asymmetric", "progress", "timed"}),
     Method("local", "._local:solve_local", "nearest neighbour + 2-opt/Or-opt, iterated with --restarts",
            ("seed", "time_limit", "progress", "restarts", "max_starts"),

@@ -28,7 +28,7 @@ from htetro_opt.solvers.sequencing import (
 )
 
 # Methods that take a plain matrix, with options that keep each well under a second here.
-MATRIX_METHODS = {"exact": {}, "ortools": {"time_limit": 0.2}, "local": {"restarts": 5}, "ga": {"patience": 5},
+MATRIX_METHODS = {"exact": {}, "ortools": {"solution_limit": 100}, "local": {"restarts": 5}, "ga": {"patience": 5},
                   "ga-plain": {"max_gen": 30}, "greedy": {"iterations": 30}, "fast-tsp": {"time_limit": 0.2},
                   "lkh": {}}
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 
@@ -32,8 +34,12 @@ def test_budgets_grow_with_the_instance_and_are_capped():
 
 
 def test_a_tiny_budget_is_honoured(instance):
+    # the time limit is the feature: how long the call ran is measured in CPU time (which a busy
+    # machine does not stretch), against a wide margin; the default run would take seconds
+    began = time.process_time()
     result = sequence_waypoints(instance, method="ga-plain", seed=0, time_limit=0.05, patience=None)
-    assert result.info["stopped"] == "time_limit" and result.runtime_s < 1.0
+    assert result.info["stopped"] == "time_limit" and time.process_time() - began < 1.0
+    assert result.time_limited
 
 
 @pytest.mark.parametrize("method,unit_total", [("ga", 2000), ("ga-plain", 2000), ("greedy", 10000), ("local", 3)])
@@ -50,7 +56,9 @@ def test_methods_report_progress_that_only_grows(instance, method, unit_total):
 def test_ortools_reports_seconds_against_its_budget(instance):
     calls = []
     sequence_waypoints(instance, method="ortools", time_limit=1.0, progress=lambda *a: calls.append(a))
-    assert calls and all(0 <= c[0] <= 1.5 and c[1] == 1.0 and c[2].startswith("cost") for c in calls)
+    # seconds spent, as the progress says them (a report comes from a solution before the limit; the
+    # margin is wide for a busy machine, where a solution may come late)
+    assert calls and all(0 <= c[0] <= 3.0 and c[1] == 1.0 and c[2].startswith("cost") for c in calls)
 
 
 def test_a_callable_method_gets_progress_only_if_it_takes_it(instance):

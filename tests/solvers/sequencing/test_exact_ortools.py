@@ -184,15 +184,17 @@ def test_ortools_handles_trivial_and_zero_cost_instances():
     one = SequencingInstance(np.zeros((1, 1)), np.zeros((1, 4, 2), dtype=int), None)
     assert solve_ortools(one)[0].tolist() == [0]
     zeros = SequencingInstance(np.zeros((5, 5)), np.zeros((5, 4, 2), dtype=int), 3)
-    order, info = solve_ortools(zeros, time_limit=0.1)
+    order, info = solve_ortools(zeros, time_limit=NO_CLOCK, solution_limit=10)
     check_order(zeros, order)
     assert info["scale"] == 1.0
 
 
-# Instances whose guided local search reaches the proved optimum after at most ~70 solutions (about
-# 0.1 s here), so a 1-s budget leaves a wide margin on a loaded machine. They check the open-path
-# model (dummy end, fixed or free start, the node-indexed matrix) end to end; the claim on
-# arbitrary instances is the slow test below.
+# Instances whose guided local search reaches the proved optimum after at most 100 solutions, so a
+# budget of 500 solutions (not seconds: the search is deterministic, so it ends at the same order on
+# any machine, however busy) leaves a wide margin. They check the open-path model (dummy end, fixed
+# or free start, the node-indexed matrix) end to end; the claim on arbitrary instances (at the
+# default time limit) is the slow test below.
+NO_CLOCK = 3600.0  # a time limit no busy machine reaches: the solution limit ends the search
 QUICK = [("euclid", 0, 20, 0), ("euclid", 0, 20, None), ("cells", 2, 20, 0), ("cells", 2, 20, None),
          ("euclid", 2, 30, 0), ("euclid", 2, 30, None), ("euclid", 12, 40, 0), ("euclid", 3, 40, None)]
 
@@ -202,10 +204,22 @@ def test_ortools_reaches_the_proved_optimum(kind, seed, n, start):
     instance = random_instance(kind, seed, n, start)
     exact, info = solve_exact(instance)
     assert info["optimal"]
-    order, extras = solve_ortools(instance, time_limit=1.0)
+    order, extras = solve_ortools(instance, time_limit=NO_CLOCK, solution_limit=500)
     check_order(instance, order)
     assert leg_sum(instance.cost, order.tolist()) == pytest.approx(leg_sum(instance.cost, exact.tolist()), rel=1e-6)
-    assert extras["time_limit_s"] == 1.0
+    assert extras["time_limit_s"] == NO_CLOCK and extras["solutions"] == 500 and not extras["time_limited"]
+
+
+def test_a_solution_limit_gives_the_same_order_and_says_the_clock_did_not_cut_it():
+    instance = random_instance("euclid", 2, 30, 0)
+    runs = [sequence_waypoints(instance, method="ortools", time_limit=NO_CLOCK, solution_limit=20) for _ in range(2)]
+    assert runs[0].order.tolist() == runs[1].order.tolist()
+    assert not runs[0].time_limited and runs[0].info["solutions"] == 20
+    timed = sequence_waypoints(instance, method="ortools", time_limit=0.05)  # guided local search never ends
+    assert timed.time_limited and timed.as_dict()["time_limited"] is True
+    for bad in (0, -1, 2.5, True):
+        with pytest.raises(ParameterError, match="solution_limit"):
+            solve_ortools(instance, solution_limit=bad)
 
 
 @pytest.mark.slow
@@ -227,7 +241,8 @@ def test_ortools_agrees_with_exact_at_default_time_limit(n):
 def test_dispatcher_runs_both(method):
     instance = random_instance("cells", 4, 9, 2)
     _, optimum = held_karp(instance.cost, start=2)
-    result = sequence_waypoints(instance, method=method, time_limit=0.5 if method == "ortools" else None)
+    options = {"time_limit": NO_CLOCK, "solution_limit": 500} if method == "ortools" else {}
+    result = sequence_waypoints(instance, method=method, **options)
     assert result.method == method
     assert result.order[0] == 2 and sorted(result.order.tolist()) == list(range(9))
     assert result.tiles == [instance.ids[i] for i in result.order]

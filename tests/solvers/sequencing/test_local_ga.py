@@ -366,16 +366,17 @@ def test_dispatcher_runs_ga_ga_plain_and_local():
 
 
 def test_memetic_ga_keeps_its_time_budget_on_300_waypoints():
-    from time import perf_counter
+    # the time limit is the feature: the run's length in CPU time (a busy machine does not stretch it)
+    from time import process_time
 
     warm = instance(euclidean(20, 0), 0)
     solve_ga(warm, seed=0, max_gen=1)  # compiles the local search, once per install (numba's cache)
     inst = instance(euclidean(300, 4), 0)
-    began = perf_counter()
+    began = process_time()
     order, info = solve_ga(inst, seed=0, time_limit=2.0, patience=None, max_gen=10**6)
-    spent = perf_counter() - began
+    spent = process_time() - began
     assert is_permutation(order, 300) and order[0] == 0
-    assert info["stopped"] == "time_limit" and spent < 2.0 + 1.0
+    assert info["stopped"] == "time_limit" and spent < 2.0 + 1.5
     assert info["generations"] > 1
 
 
