@@ -391,6 +391,6 @@ def test_the_sequence_methods_add_the_fields_listed(examples):
     instance = SequencingInstance.from_tileset(load_tileset(examples / "tiles.txt"), start=1)
     for method in sorted(listed):
         taken = SPEC.method(method).takes  # LKH counts runs, not seconds; the patterns take neither
-        options = {k: v for k, v in {"time_limit": 0.2, "seed": 0}.items() if taken(k)}
+        options = {k: v for k, v in {"time_limit": 0.2, "seed": 0, "solution_limit": 10}.items() if taken(k)}
         result = sequence_waypoints(instance, method=method, **options)
         assert set(result.info) - {"additions"} == listed[method], method  # additions: a field of its own

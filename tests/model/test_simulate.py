@@ -176,10 +176,10 @@ SIMULATE = sys.modules["htetro_opt.model.simulate"]  # the module (htetro_opt.mo
 def test_a_huge_map_is_refused_at_once_naming_the_memory(monkeypatch):
     monkeypatch.setattr(Simulator, "_transition_table", lambda self: pytest.fail("allocated before the check"))
     huge = Workspace(np.zeros((5000, 5000), dtype=bool))
-    began = time.perf_counter()
+    began = time.process_time()  # "at once" in CPU time, which a busy machine does not stretch
     with pytest.raises(PlanningError) as info:
         Simulator(huge)
-    assert time.perf_counter() - began < 2.0
+    assert time.process_time() - began < 2.0
     message = str(info.value)
     assert "5000 x 5000 map" in message and "GiB of memory, more than the budget of" in message
     assert re.search(r"fit a map of at most [\d,]+ cells \(e\.g\. \d+ x \d+\)", message), message

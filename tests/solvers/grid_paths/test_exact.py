@@ -244,10 +244,10 @@ def test_a_huge_map_is_refused_at_once_saying_how_much_memory_and_what_fits(monk
     monkeypatch.setattr(Simulator, "_transition_table", lambda self: pytest.fail("allocated before the check"))
     monkeypatch.setattr(np, "full", lambda *a, **k: pytest.fail("allocated before the check"))
     huge = Workspace(np.zeros((side, side), dtype=bool))
-    began = time.perf_counter()
+    began = time.process_time()  # "at once" in CPU time, which a busy machine does not stretch
     with pytest.raises(PlanningError) as info:
         plan_path(huge, [Pose(1, 1, "O", 0), Pose(side - 3, side - 3, "O", 0)], method=method, memory_budget=budget)
-    assert time.perf_counter() - began < 2.0
+    assert time.process_time() - began < 2.0
     message = str(info.value)
     needed = _needed_bytes(message)
     limit = float(re.search(r"more than the budget of ([\d.]+) (MiB|GiB)", message)[1])
