@@ -40,7 +40,7 @@ INSTANCES = {
     "tiling": {"scenario": "tiling_64x64", "warm": "tiling_6x6", "options": {}, "warm_options": {}},
     "sequencing": {"scenario": str(DATA / "pr1002.tsp"), "warm": str(DATA / "eil51.tsp"),
                    "options": {"closed": True}, "warm_options": {"closed": True}},
-    "coverage": {"scenario": "coverage_16x16", "warm": "coverage_16x7", "options": {}, "warm_options": {}},
+    "coverage": {"scenario": "tiling_64x64", "warm": "coverage_16x7", "options": {}, "warm_options": {}},
 }
 
 # A method's own instance where the task's does not suit it: the exact sequencer proves optima of at most

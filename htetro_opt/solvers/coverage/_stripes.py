@@ -751,9 +751,13 @@ class _Planner:
                 return math.inf
             return plan_total(self.lg, self.cov, self._vertex_path(g, dag_path), found, self.goal, self.mopup)
 
+        if self.deadline is not None and time.perf_counter() > self.deadline:
+            self.time_limited = True
+            return 0  # no time left: the greedy order stands (each try costs a DAG search and its mop-up)
         self._from = {}
         current = [(sweep, sweep.direction) for sweep in self.sweeps]
         best, tries = cost(current), 1
+        last = current  # the order the sweeps' directions and regions were last set for
         improved = True
         while improved and tries < ORDER_TRIES:
             improved = False
@@ -765,12 +769,13 @@ class _Planner:
                 order = list(current)
                 sweep, d = order.pop(i)
                 order.insert(j, (sweep, -d if flip else d))
-                found = cost(order)
+                found, last = cost(order), order
                 tries += 1
                 if found < best:
                     best, current, improved = found, order, True
                     break
-        cost(current)
+        if last is not current:
+            cost(current)  # set the sweeps back to the best order's directions and regions
         self.sweeps = [sweep for sweep, _ in current]
         self._from = None  # a large map's arrays: not kept past the search
         return tries
@@ -883,10 +888,17 @@ def plan_stripes(lg: LayerGraph, cov: Coverability, start: int, goal: int | None
     planner = _Planner(lg, cov, start, goal, widths, **options, widening=first, ends=ends)
     runs = {(first, ends): planner.plan()}
     widenings = [first] + (["joined"] if split and planner.choices else [])
+    cut = False
     for widening, e in [(w, e) for e in dict.fromkeys((ends, "sweep")) for w in widenings]:
-        if (widening, e) not in runs:  # "both" keeps "sweep"'s plan as a candidate: never costlier with its mop-up
-            runs[(widening, e)] = _Planner(lg, cov, start, goal, widths, **options, widening=widening, ends=e).plan()
+        if (widening, e) in runs:
+            continue
+        if deadline is not None and time.perf_counter() > deadline:
+            cut = True  # a time limit: the candidates planned so far (the first is always planned)
+            break
+        # "both" keeps "sweep"'s plan as a candidate: never costlier with its mop-up
+        runs[(widening, e)] = _Planner(lg, cov, start, goal, widths, **options, widening=widening, ends=e).plan()
     if len(runs) == 1:
+        runs[(first, ends)].time_limited |= cut
         return runs[(first, ends)]
 
     costs = {key: math.inf if o.dag_cost is None else plan_total(lg, cov, o.path, o.dag_cost, goal, mopup)
@@ -903,6 +915,6 @@ def plan_stripes(lg: LayerGraph, cov: Coverability, start: int, goal: int | None
     best.info["ends"] = key[1]
     for name in ("regions", "regions_optimal", "memo_hits", "nodes"):  # every plan's searches count
         setattr(best, name, sum(getattr(o, name) for o in runs.values()))
-    best.time_limited = any(o.time_limited for o in runs.values())
+    best.time_limited = cut or any(o.time_limited for o in runs.values())
     best.failed = {k: v for o in runs.values() for k, v in o.failed.items()}  # every search of the run counts
     return best

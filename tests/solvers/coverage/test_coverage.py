@@ -377,6 +377,23 @@ def test_time_limit_is_a_result_not_an_error():
     assert plan.time_limited and plan.complete
 
 
+def test_past_the_time_limit_no_sweep_order_is_tried_and_no_second_candidate_planned(monkeypatch):
+    """Once the limit has passed the plan is the first candidate, in the greedy sweep order: the order
+    search (each try a DAG search with its mop-up) and the other widening's plan are not started."""
+    from htetro_opt.solvers.coverage import _stripes
+
+    planned = []
+    plan_one = _stripes._Planner.plan
+    monkeypatch.setattr(_stripes._Planner, "plan", lambda self: planned.append(self.widening) or plan_one(self))
+    ws = load_scenario("coverage_16x16").workspace
+    plan = plan_coverage(ws, "O,vI,hI", time_limit=1e-6)
+    assert plan.time_limited and plan.complete
+    assert plan.info["order_tries"] == 0 and len(planned) == 1
+    planned.clear()
+    unlimited = plan_coverage(ws, "O,vI,hI")  # the same map without a limit: orders tried, both widenings
+    assert unlimited.info["order_tries"] > 0 and len(planned) == 2
+
+
 def test_a_layer_cut_off_at_the_top_edge_is_still_entered():
     # At the top of a free map the vertical I cannot switch to the O (B4 would swing off the map), so
     # the top stripe has two pieces; the vertical I enters its own by the cut-edge and sweeps it.
