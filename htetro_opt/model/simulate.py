@@ -418,6 +418,20 @@ class SimulationResult:
         return Pose(x, y, STATE_NAMES[s], h)
 
 
+def _pose_id(ws, n_states: int, pose) -> int:
+    """The id of ``pose`` on ``ws``'s pose grid, ((state · 4 + heading) · height + y) · width + x, as
+    :meth:`Simulator.encode` numbers poses (and the graph-free exact planner's pose space), with the
+    checks both make: a state the command set reaches, a cell on the map."""
+    pose = as_pose(pose)
+    s = shape_index(pose.shape)
+    if s >= n_states:
+        raise ConfigurationError(f"state {pose.shape!r} is an intermediate state: it needs Cheng et al. 2019's "
+                                 "block commands (1l, 1r, 3l, 3r, 4l, 4r) in the simulator's command set")
+    if not ws.contains(pose.x, pose.y):
+        raise ConfigurationError(f"pose ({pose.x}, {pose.y}) lies outside the {ws.width} x {ws.height} map")
+    return int(((s * N_HEADINGS + pose.heading) * ws.height + pose.y) * ws.width + pose.x)
+
+
 class Simulator:
     """Compiled transition tables of one workspace for one command set.
 
@@ -552,14 +566,7 @@ class Simulator:
         ConfigurationError
             If the pose is outside the map or its state is not used by this simulator.
         """
-        pose, ws = as_pose(pose), self.workspace
-        s = shape_index(pose.shape)
-        if s >= self.n_states:
-            raise ConfigurationError(f"state {pose.shape!r} is an intermediate state: it needs Cheng et al. 2019's "
-                                     "block commands (1l, 1r, 3l, 3r, 4l, 4r) in the simulator's command set")
-        if not ws.contains(pose.x, pose.y):
-            raise ConfigurationError(f"pose ({pose.x}, {pose.y}) lies outside the {ws.width} x {ws.height} map")
-        return int(((s * N_HEADINGS + pose.heading) * ws.height + pose.y) * ws.width + pose.x)
+        return _pose_id(self.workspace, self.n_states, pose)
 
     def decode(self, ids) -> np.ndarray:
         """(x, y, state, heading) of flat pose ids, shape (..., 4)."""

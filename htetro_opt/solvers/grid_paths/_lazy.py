@@ -39,9 +39,9 @@ import numpy as np
 
 from htetro_opt._jit import lazy_jit
 from htetro_opt.errors import ConfigurationError, PlanningError
-from htetro_opt.model.commands import COMMANDS, command_id
-from htetro_opt.model.robot import N_HEADINGS, Pose, as_pose, shape_index
-from htetro_opt.model.simulate import _resolve_commands, _states_of
+from htetro_opt.model.commands import command_id
+from htetro_opt.model.robot import N_HEADINGS, Pose, as_pose
+from htetro_opt.model.simulate import _pose_id, _resolve_commands, _states_of
 from htetro_opt.model.sweeps import SweepTables, sweep_tables
 from htetro_opt.model.workspace import Workspace, describe_cells, grid_distance
 
@@ -180,14 +180,7 @@ class PoseSpace:
 
     # --- poses, as the Simulator's -------------------------------------------------------------------
     def encode(self, pose: Pose) -> int:
-        pose, ws = as_pose(pose), self.workspace
-        s = shape_index(pose.shape)
-        if s >= self.n_states:
-            raise ConfigurationError(f"state {pose.shape!r} is an intermediate state: it needs Cheng et al. 2019's "
-                                     "block commands (1l, 1r, 3l, 3r, 4l, 4r) in the simulator's command set")
-        if not ws.contains(pose.x, pose.y):
-            raise ConfigurationError(f"pose ({pose.x}, {pose.y}) lies outside the {ws.width} x {ws.height} map")
-        return int(((s * N_HEADINGS + pose.heading) * ws.height + pose.y) * ws.width + pose.x)
+        return _pose_id(self.workspace, self.n_states, pose)
 
     def internal(self, pose_id: int) -> int:
         """The search's id ``cell * n_sh + sh`` of a Simulator pose id ``sh * n_cells + cell``."""
@@ -309,7 +302,6 @@ def _bucket_search(state, goal, n_sh, w, wf, m, n_commands, usable, target_sh, r
     """
     nb = len(head)
     block = len(pool) // len(block_next)
-    pmask = (1 << pbits) - 1
     cur, queued, n_free, expanded = state[1], state[2], state[3], state[4]
     status = _UNREACHABLE_
     while queued > 0:
