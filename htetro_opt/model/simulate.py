@@ -344,16 +344,21 @@ def check_memory(needed: int, what: str, advice: str) -> None:
 
 
 def size_text(n: int) -> str:
-    """A number of bytes for a message, in GiB from 1 GiB up, in MiB below.
+    """A number of bytes for a message, in GiB from 1 GiB up, in MiB from 1 MiB up, in KiB or bytes below
+    (a budget of a few KiB is not "0.0 MiB").
 
     Examples
     --------
     >>> size_text(3 * 2**29), size_text(2**40)
     ('1.5 GiB', '1024.0 GiB')
-    >>> size_text(2**20)
-    '1.0 MiB'
+    >>> size_text(2**20), size_text(1024), size_text(100)
+    ('1.0 MiB', '1.0 KiB', '100 bytes')
     """
-    return f"{n / 2**30:.1f} GiB" if n >= 2**30 else f"{n / 2**20:.1f} MiB"
+    if n >= 2**30:
+        return f"{n / 2**30:.1f} GiB"
+    if n >= 2**20:
+        return f"{n / 2**20:.1f} MiB"
+    return f"{n / 2**10:.1f} KiB" if n >= 2**10 else f"{int(n)} bytes"
 
 
 @dataclass(frozen=True, eq=False)
