@@ -170,7 +170,7 @@ def _end() -> None:
     for path in list(_temporaries):
         try:
             os.unlink(path)
-        except OSError:
+        except OSError:  # already renamed into place or removed: nothing half-written is left either way
             pass
     os._exit(code)
 
@@ -196,7 +196,7 @@ def exit_now(code: int) -> None:
     for stream in (sys.stdout, sys.stderr):
         try:
             stream.flush()
-        except (OSError, ValueError):
+        except (OSError, ValueError):  # a closed stream or a gone pipe: the exit status still says why
             pass
     os._exit(code)
 

@@ -28,7 +28,7 @@ def whole_number(text: str) -> int:
     option's own bound, which says what that many would cost, rather than a parse error)."""
     try:
         return int(text)
-    except ValueError:
+    except ValueError:  # not a plain integer: read below as a number such as 1e5
         pass
     try:
         value = float(text)

@@ -114,7 +114,7 @@ def _die_with(parent: int) -> None:
 
             libc = ctypes.CDLL(None, use_errno=True)
             libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # 1: PR_SET_PDEATHSIG
-        except (OSError, AttributeError):
+        except (OSError, AttributeError):  # a libc without prctl: the parent-watch thread below ends the worker
             pass
     if _orphaned(parent):  # the parent died before prctl: nothing will kill this worker
         os._exit(1)
