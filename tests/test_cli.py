@@ -1057,7 +1057,10 @@ def test_cover_boustrophedon_and_auto_start(capsys):
     assert stripes["complete"] and bous["complete"] and stripes["action_cost"] <= bous["action_cost"]
     assert stripes["goal"] is None and bous["method"] == "boustrophedon"
     code, out, err = run(capsys, ["cover", "coverage_16x7", "--start", "auto", "--shapes", "O,hI"])
-    assert code == 0 and "commands" in out.splitlines()[0]
+    assert code == 0 and "commands" in out.splitlines()[0] and "region searches optimal" in out
+    # the baseline runs no region search: its line does not count "0 of 0" of them
+    code, out, err = run(capsys, ["cover", "coverage_16x7", "--method", "boustrophedon", "--shapes", "O,hI"])
+    assert code == 0 and "commands" in out.splitlines()[0] and "region searches" not in out
     for method, more in (("stripes-paper", ["--additions", "greedy-fallback,mopup"]), ("tiling-tsp", [])):
         other = run_json(capsys, ["cover", "coverage_16x16", "--method", method, "--shapes", "O,vI,hI", *more,
                                   "--json"])

@@ -64,9 +64,10 @@ def run(args) -> dict:
         state = "complete" if plan.complete else f"incomplete ({len(plan.uncoverable)} free cells uncoverable)"
         if not plan.success:  # the paper's algorithm left cells or ran out of nodes: said, not rescued
             state = f"not successful: {plan.message}"
+        # only the region-searching methods (stripes) have region searches to count
+        searches = (f"{plan.regions_optimal} of {plan.regions} region searches optimal, " if plan.regions else "")
         print(f"{problem.name}: {method.name} with {','.join(plan.layers)}: {plan.action_cost} commands, {state}, "
-              f"average coverage time {plan.average_coverage_time:.3f}, {plan.regions_optimal} of {plan.regions} "
-              f"region searches optimal, {plan.runtime_s:.3f} s")
+              f"average coverage time {plan.average_coverage_time:.3f}, {searches}{plan.runtime_s:.3f} s")
         if plan.time_limited:
             print("the time limit cut the region searches short: the plan depends on the machine's speed")
         print(",".join(plan.tokens))
