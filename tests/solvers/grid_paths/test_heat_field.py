@@ -176,16 +176,36 @@ def test_p0_is_the_five_point_scheme():
     np.testing.assert_allclose(field.cells, expected, atol=1e-12)
 
 
-def skfem_reference(occ, source, sink, k_obstacle, scale):
-    """Q1 with scikit-fem's own assembly on the conducting cells (unsplit), k scaled by ``scale``."""
+def pinch_nodes(occ) -> set[tuple[int, int]]:
+    """Interior nodes (x, y) where two free cells touch only at that corner (two diagonal patterns)."""
+    free = ~occ
+    h, w = occ.shape
+    return {(x, y) for y in range(1, h) for x in range(1, w)
+            if (free[y - 1, x - 1] and free[y, x] and not free[y - 1, x] and not free[y, x - 1])
+            or (free[y - 1, x] and free[y, x - 1] and not free[y - 1, x - 1] and not free[y, x])}
+
+
+def skfem_reference(occ, source, sink, k_obstacle, scale, split=False):
+    """Q1 with scikit-fem's own assembly on the conducting cells, k scaled by ``scale``; with ``split``
+    every pinch node is one mesh node per element around it."""
     w = occ.shape[1]
     cells = np.argwhere(np.ones_like(occ) if k_obstacle > 0 else ~occ)  # (y, x)
     corner = [(0, 0), (1, 0), (1, 1), (0, 1)]  # counter-clockwise (i, j)
-    t = np.array([[(y + j) * (w + 1) + x + i for i, j in corner] for y, x in cells]).T
-    used, t = np.unique(t, return_inverse=True)
-    t = t.reshape(4, -1)
-    p = np.vstack([used % (w + 1), used // (w + 1)]).astype(float)
-    mesh = fem.MeshQuad1(p, t)
+    pinches = pinch_nodes(occ) if split else set()
+    keys = {}  # a mesh node per grid node, or per (grid node, element) at a pinch
+    t, p = [], []
+    for y, x in cells:
+        column = []
+        for i, j in corner:
+            node = (int(x + i), int(y + j))
+            key = (node, (int(x), int(y))) if node in pinches else (node, None)
+            if key not in keys:
+                keys[key] = len(keys)
+                p.append(node)
+            column.append(keys[key])
+        t.append(column)
+    t = np.array(t).T
+    mesh = fem.MeshQuad1(np.array(p, dtype=float).T, t)
     basis = fem.Basis(mesh, fem.ElementQuad1())
     basis0 = basis.with_element(fem.ElementQuad0())
     k = scale * np.where(occ[cells[:, 0], cells[:, 1]], k_obstacle, 1.0)
@@ -220,6 +240,25 @@ def test_q1_matches_scikit_fem_and_ignores_the_conductivity_scale(scale):
         np.testing.assert_allclose(field.cells, expected, atol=1e-10)
         compared += 1
     assert compared >= 5
+
+
+def test_split_pinches_match_scikit_fem_on_a_mesh_with_the_copies():
+    """The split mesh assembled by scikit-fem (a node per element at each pinch) gives our field, with
+    obstacles conducting (all four elements at a pinch carry a copy) and removed (two do)."""
+    compared = 0
+    for seed in range(40):
+        occ, source, sink = random_case(seed)
+        if abs(source[0] - sink[0]) <= 1 and abs(source[1] - sink[1]) <= 1 or not pinch_nodes(occ):
+            continue
+        for k_obstacle in (0.05, 0.0):
+            field = solve_heat_field(Workspace(occ), source, sink, k_obstacle=k_obstacle)
+            assert field.info["pinches"] == len(pinch_nodes(occ))
+            if not field.connected or np.isnan(field.cells[~occ]).any():
+                continue  # free regions without a prescribed cell: singular for the plain reference
+            expected = skfem_reference(occ, source, sink, k_obstacle, 1.0, split=True)
+            np.testing.assert_allclose(field.cells, expected, atol=1e-10)
+            compared += 1
+    assert compared >= 8
 
 
 @pytest.mark.parametrize("element", ["q1", "p0"])
