@@ -189,13 +189,21 @@ class _Space:
                      f"cells on this {ws.width} x {ws.height} map", "give a smaller band radius, or a smaller map")
         xy = np.column_stack([cells % ws.width, cells // ws.width])
         target = transitions_at(ws, xy, commands=list(ids), clearance=tables.clearance).reshape(n, len(ids))
-        local_of_cell = np.full(hw, -1, dtype=np.int64)
-        local_of_cell[cells] = np.arange(len(cells))
-        valid = target >= 0
-        g = np.where(valid, target, 0)
-        band_cell = local_of_cell[g % hw]
-        local = band_cell * per_cell + g // hw
-        local[~valid | (band_cell < 0)] = n  # dead, or out of the band
+        # Global id g = state' * H * W + cell: local = (band index of the cell) * per_cell + state'. In
+        # int32 where the ids fit and with few temporaries: this table has 14.7 million entries on a
+        # 1000 x 1000 map (band r 8), where each pass over it costs.
+        index = np.int32 if per_cell * hw < 2**31 and n < 2**31 else np.int64
+        g = target.astype(index)
+        del target
+        state = g // index(hw)  # -1 for a dead entry
+        g -= state * index(hw)  # the target's cell
+        first = np.full(hw, n, dtype=index)  # out of the band: n, which the minimum below keeps
+        first[cells] = np.arange(0, n, per_cell, dtype=index)
+        local = first[g]
+        del g
+        local += state
+        np.minimum(local, n, out=local)
+        local[state < 0] = n  # dead
         sim = SimpleNamespace(workspace=ws, tables=tables, command_ids=np.asarray(ids, dtype=np.int64),
                               n_commands=len(ids), n_states=n_states, n_poses=n, dead=n, next=local,
                               durations=np.append(durations, 0.0))
@@ -639,15 +647,17 @@ def plan_heat(
             found = searcher.run(a, b)
             return None if found is None else _Found(*found, None, searcher.waves, searcher.expanded, weights)
         target = sim.next[:n, :c]
-        time_cost = np.broadcast_to(sim.durations[:c] / t_max, (n, c))
+        # Per-command costs stay (c,) rows broadcast over the poses until a per-pose term enters: an
+        # (n, c) array is 14.7 million entries on a 1000 x 1000 band
+        time_cost = sim.durations[:c] / t_max
         tie = _TIE_BREAK * time_cost
-        timer = _LegSearch(space, mask, time_cost + tie, 0.0, leg_engine)
+        timer = _LegSearch(space, mask, np.broadcast_to(time_cost + tie, (n, c)), 0.0, leg_engine)
         timed = timer.run(a, b)
         if timed is None or (weights[1] == 0 and weights[2] == 0):
             return None if timed is None else _Found(*timed, len(timed[0]), timer.waves, timer.expanded, weights)
         length = max(len(timed[0]), 1)
         total = sum(weights)
-        cost = weights[0] * time_cost / total + tie
+        cost = np.broadcast_to(weights[0] * time_cost / total + tie, (n, c))
         if weights[2] > 0:
             cost = cost + weights[2] * space.safety[np.minimum(target, n - 1)] / (length * total)
         searcher = _LegSearch(space, mask, cost, weights[1] / (length * total), leg_engine)
@@ -663,10 +673,9 @@ def plan_heat(
             n, c = sim.n_poses, sim.n_commands
             target = sim.next[:n, :c]
             moves = np.array([COMMANDS[int(g)].kind in _MOVES for g in sim.command_ids])
-            temperature = field.cells.ravel()
-            here = temperature[space.cell_of][:, None]
-            there = temperature[space.cell_of[np.minimum(target, n - 1)]]  # dead targets: masked by the graph
-            mask = ~moves[None, :] | (there >= here - field.epsilon)
+            here = field.cells.ravel()[space.cell_of]  # the temperature of every pose's B2 cell
+            there = here[np.minimum(target, n - 1)]  # dead targets: masked by the graph
+            mask = ~moves[None, :] | (there >= here[:, None] - field.epsilon)
         own = weighted(space, a, b, mask, w)
         if not pick or own is None or exact_time:
             return own
