@@ -374,20 +374,22 @@ def solve_heat_field(workspace, source, sink, *, element: str = "q1", k_obstacle
 
 def _interior_system(matrix: csr_matrix, interior: np.ndarray, prescribed: np.ndarray):
     """``A = K[interior, interior]`` and ``b = -K[interior, :] @ prescribed`` (prescribed zero off the
-    Dirichlet dofs): the rows sliced once, the columns kept by a lookup table (scipy's column fancy
-    index costs 0.2 s at a million dofs, measured)."""
+    Dirichlet dofs): the rows sliced once, the columns renumbered by a lookup table (scipy's column
+    fancy index costs 0.2 s at a million dofs, measured). The interior's rows reach no other region,
+    so the only columns dropped are the few Dirichlet dofs'."""
     rows = matrix[interior]
     b = -(rows @ prescribed)
     column = np.full(matrix.shape[1], -1, dtype=np.int32)
     column[interior] = np.arange(len(interior), dtype=np.int32)
-    mapped = column[rows.indices]
-    keep = mapped >= 0
-    kept = np.zeros(len(keep) + 1, dtype=np.int64)
-    np.cumsum(keep, out=kept[1:])
-    indptr = kept[rows.indptr]
+    indices = column[rows.indices]
+    data, indptr = rows.data, rows.indptr.astype(np.int64)
+    drop = np.flatnonzero(indices < 0)
+    if len(drop):
+        indices, data = np.delete(indices, drop), np.delete(data, drop)
+        dropped = np.bincount(np.searchsorted(indptr, drop, side="right") - 1, minlength=len(interior))
+        indptr[1:] -= np.cumsum(dropped)
     index_type = np.int32 if indptr[-1] < 2**31 else np.int64
-    a = csr_matrix((rows.data[keep], mapped[keep], indptr.astype(index_type)), shape=(len(interior),) * 2)
-    return a, b
+    return csr_matrix((data, indices, indptr.astype(index_type)), shape=(len(interior),) * 2), b
 
 
 def _solve(a, b: np.ndarray, solver: str, tol: float) -> tuple[np.ndarray, int]:
@@ -398,6 +400,10 @@ def _solve(a, b: np.ndarray, solver: str, tol: float) -> tuple[np.ndarray, int]:
 
     residuals: list[float] = []
     with threadpool_limits(1):
-        hierarchy = pyamg.ruge_stuben_solver(a)
+        # One forward Gauss–Seidel sweep before the coarse correction and one backward after (the
+        # V-cycle stays symmetric, as CG needs): 20 iterations of half the smoothing instead of 18 of
+        # symmetric sweeps on both sides, 1.18 against 1.42 CPU s at 1000 x 1000 (setup 0.8 s either way)
+        hierarchy = pyamg.ruge_stuben_solver(a, presmoother=("gauss_seidel", {"sweep": "forward"}),
+                                             postsmoother=("gauss_seidel", {"sweep": "backward"}))
         x = hierarchy.solve(b, tol=tol, accel="cg", maxiter=1000, residuals=residuals)
     return x, max(len(residuals) - 1, 0)
