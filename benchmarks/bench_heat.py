@@ -13,18 +13,28 @@
    plan reaches; mean gap to the optimum).
 4. Weighted plans (w_sm > 0 puts the last command in the search state): 24 x 24 maps and the
    128 x 128 indoor room.
+5. End to end on 1000 x 1000 (issue 25: <= 5 s): time-only heat (band auto) and a side-by-side
+   baseline alternate in fresh processes, heat, baseline, heat, ...: scipy's Dijkstra for a point
+   robot over the same free cells (8-connected, no corner cutting, graph build included). Per run the
+   plan call's CPU and wall seconds, the field's CPU share, the process's CPU seconds (imports and map
+   included) and peak RSS; the medians, the median of the pairwise CPU ratios heat / baseline, and
+   the load average before and after.
 
 Synthetic N x N maps: axis-aligned rectangles with sides drawn in [2, N/33) placed uniformly (fixed
 seeds) until at least 20 % of the cells are blocked; O-shaped start (10, 10) and goal (N - 10, N - 10)
 on cleared 9 x 9 squares.
 
 Run:  python benchmarks/bench_heat.py [--sizes 24,128,512,1000] [--clutter 100] [--skip-plans]
+                                      [--pairs 3] [--only-e2e]
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import multiprocessing as mp
+import os
+import resource
 import statistics
 import time
 
@@ -79,11 +89,31 @@ def _child(job, queue):
 
     kind, n, options = job
     ws, roadmap = synthetic(n)
+    field_cpu = []
+    if kind == "heat":  # the field's CPU seconds (its info holds wall seconds only)
+        import htetro_opt.solvers.grid_paths._heat as heat_module
+
+        solve = heat_module.solve_heat_field
+
+        def timed(*args, **kwargs):
+            began = time.process_time()
+            try:
+                return solve(*args, **kwargs)
+            finally:
+                field_cpu.append(time.process_time() - began)
+
+        heat_module.solve_heat_field = timed
     cpu, wall = time.process_time(), time.perf_counter()
+    if kind == "point":
+        reached, plan_time = _point_dijkstra(ws, (roadmap[0].x, roadmap[0].y), (roadmap[1].x, roadmap[1].y))
+        queue.put({"kind": kind, "n": n, "reached": reached, "time": plan_time,
+                   "cpu_s": time.process_time() - cpu, "wall_s": time.perf_counter() - wall,
+                   "process_cpu_s": _process_cpu(), "rss_gb": _peak_rss_gb()})
+        return
     if kind == "heat":
         plan = plan_heat(ws, roadmap, **options)
         extra = {"band": plan.info["band"][0], "field_s": plan.info["field"][0]["seconds"],
-                 "relaxed": plan.info["relaxed"]}
+                 "field_cpu_s": sum(field_cpu), "relaxed": plan.info["relaxed"]}
     else:
         from htetro_opt.errors import PlanningError
 
@@ -98,7 +128,38 @@ def _child(job, queue):
         extra = {"method": plan.method}
     queue.put({"kind": kind, "n": n, "options": options, "reached": plan.reached, "time": plan.time,
                "cpu_s": time.process_time() - cpu, "wall_s": time.perf_counter() - wall,
-               "rss_gb": _peak_rss_gb(), **extra})
+               "process_cpu_s": _process_cpu(), "rss_gb": _peak_rss_gb(), **extra})
+
+
+def _point_dijkstra(ws, start, goal) -> tuple[bool, float]:
+    """The baseline: scipy's Dijkstra for a point robot on the free cells, 8-connected (steps 1 and
+    sqrt 2, a diagonal only between two free orthogonal cells), the graph built here."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    free = ~ws.occupancy
+    h, w = free.shape
+    index = np.arange(h * w).reshape(h, w)
+    rows, cols, data = [], [], []
+    for dy, dx in ((0, 1), (1, 0), (1, 1), (1, -1)):
+        ys, xs = slice(0, h - dy), slice(max(0, -dx), w - max(0, dx))
+        yt, xt = slice(dy, h), slice(max(0, dx), w - max(0, -dx))
+        ok = free[ys, xs] & free[yt, xt]
+        if dy and dx:  # no corner cutting: both orthogonal cells free
+            ok &= free[yt, xs] & free[ys, xt]
+        rows.append(index[ys, xs][ok])
+        cols.append(index[yt, xt][ok])
+        data.append(np.full(int(ok.sum()), math.sqrt(2.0) if dy and dx else 1.0))
+    graph = coo_matrix((np.concatenate(data), (np.concatenate(rows), np.concatenate(cols))), shape=(h * w,) * 2).tocsr()
+    distance = dijkstra(graph, directed=False, indices=start[1] * w + start[0])
+    d = float(distance[goal[1] * w + goal[0]])
+    return bool(np.isfinite(d)), d
+
+
+def _process_cpu() -> float:
+    """This process's CPU seconds so far (user + system), imports and map generation included."""
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
 
 
 def _peak_rss_gb() -> float:
@@ -229,18 +290,54 @@ def weighted():
     print()
 
 
+def end_to_end(n: int = 1000, pairs: int = 3):
+    """Heat and the point-robot baseline alternated in fresh processes; medians and pairwise ratios."""
+    load_before = os.getloadavg()
+    runs = {"heat": [], "point": []}
+    for _ in range(pairs):
+        for kind in ("heat", "point"):
+            runs[kind].append(measured((kind, n, {})))
+    load_after = os.getloadavg()
+    heat, point = runs["heat"], runs["point"]
+    assert all(r["reached"] for r in heat + point)
+
+    def med(rows, key):
+        return statistics.median(r[key] for r in rows)
+
+    ratio = statistics.median(h["cpu_s"] / p["cpu_s"] for h, p in zip(heat, point))
+    wall_ratio = statistics.median(h["wall_s"] / p["wall_s"] for h, p in zip(heat, point))
+    share = statistics.median(h["field_cpu_s"] / h["cpu_s"] for h in heat)
+    print(f"## End to end, {n} x {n} (median of {pairs} fresh-process runs each, heat and baseline in turn; "
+          f"load average {load_before[0]:.1f} before, {load_after[0]:.1f} after)\n")
+    print("| run | plan CPU s (min-max) | plan wall s | field CPU s (share) | process CPU s | peak RSS GB | result |")
+    print("|---|---:|---:|---:|---:|---:|---|")
+    print(f"| heat, band auto | {med(heat, 'cpu_s'):.2f} ({min(r['cpu_s'] for r in heat):.2f}-"
+          f"{max(r['cpu_s'] for r in heat):.2f}) | {med(heat, 'wall_s'):.2f} | {med(heat, 'field_cpu_s'):.2f} "
+          f"({share:.0%}) | {med(heat, 'process_cpu_s'):.2f} | {med(heat, 'rss_gb'):.2f} | time {heat[0]['time']:.1f} s |")
+    print(f"| point-robot Dijkstra (scipy, free cells) | {med(point, 'cpu_s'):.2f} ({min(r['cpu_s'] for r in point):.2f}-"
+          f"{max(r['cpu_s'] for r in point):.2f}) | {med(point, 'wall_s'):.2f} | – | {med(point, 'process_cpu_s'):.2f} | "
+          f"{med(point, 'rss_gb'):.2f} | length {point[0]['time']:.1f} cells |")
+    print(f"\nheat / baseline, median of the pairwise ratios: CPU {ratio:.2f}, wall {wall_ratio:.2f}.\n")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", default="24,128,512,1000")
     parser.add_argument("--clutter", type=int, default=100)
     parser.add_argument("--skip-plans", action="store_true")
+    parser.add_argument("--pairs", type=int, default=3, help="end-to-end runs of heat and of the baseline")
+    parser.add_argument("--only-e2e", action="store_true", help="run part 5 only")
     args = parser.parse_args()
     sizes = [int(v) for v in args.sizes.split(",")]
+    if args.only_e2e:
+        end_to_end(pairs=args.pairs)
+        return
     fields(sizes)
     if not args.skip_plans:
         plans(sizes)
     quality(args.clutter)
     weighted()
+    end_to_end(pairs=args.pairs)
 
 
 if __name__ == "__main__":
