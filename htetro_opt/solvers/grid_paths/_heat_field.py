@@ -218,12 +218,13 @@ def _q1_matrix(conductivity: np.ndarray, dofs: np.ndarray, size: int) -> csr_mat
             stencil[(jb - ja + 1) * 3 + (ib - ia + 1), ja:ja + h, ia:ia + w] += ke[a, b] * k
     stencil = stencil.reshape(9, grid).T  # (node, slot): row by row, columns ascending
     on = stencil != 0  # obstacle-only neighbours (k = 0) store nothing; Q1's entries never cancel
-    # int32 indices (pyamg's and SuperLU's own type; a map this code can hold has < 2**31 dofs)
-    offsets = np.array([dj * (w + 1) + di for dj in (-1, 0, 1) for di in (-1, 0, 1)], dtype=np.int32)
-    indptr = np.zeros(size + 1, dtype=np.int32)
-    np.cumsum(on.sum(axis=1, dtype=np.int32), out=indptr[1:grid + 1])
+    # int32 indices (pyamg's and SuperLU's own type) unless the entries could overflow them
+    index = np.int32 if 9 * size < 2**31 else np.int64
+    offsets = np.array([dj * (w + 1) + di for dj in (-1, 0, 1) for di in (-1, 0, 1)], dtype=index)
+    indptr = np.zeros(size + 1, dtype=index)
+    np.cumsum(on.sum(axis=1, dtype=index), out=indptr[1:grid + 1])
     indptr[grid + 1:] = indptr[grid]
-    indices = (np.arange(grid, dtype=np.int32)[:, None] + offsets)[on]
+    indices = (np.arange(grid, dtype=index)[:, None] + offsets)[on]
     matrix = csr_matrix((stencil[on], indices, indptr), shape=(size, size))
     if special.any():
         ey, ex = np.nonzero(special)
