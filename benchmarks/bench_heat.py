@@ -311,12 +311,14 @@ def end_to_end(n: int = 1000, pairs: int = 3):
           f"load average {load_before[0]:.1f} before, {load_after[0]:.1f} after)\n")
     print("| run | plan CPU s (min-max) | plan wall s | field CPU s (share) | process CPU s | peak RSS GB | result |")
     print("|---|---:|---:|---:|---:|---:|---|")
-    print(f"| heat, band auto | {med(heat, 'cpu_s'):.2f} ({min(r['cpu_s'] for r in heat):.2f}-"
-          f"{max(r['cpu_s'] for r in heat):.2f}) | {med(heat, 'wall_s'):.2f} | {med(heat, 'field_cpu_s'):.2f} "
-          f"({share:.0%}) | {med(heat, 'process_cpu_s'):.2f} | {med(heat, 'rss_gb'):.2f} | time {heat[0]['time']:.1f} s |")
-    print(f"| point-robot Dijkstra (scipy, free cells) | {med(point, 'cpu_s'):.2f} ({min(r['cpu_s'] for r in point):.2f}-"
-          f"{max(r['cpu_s'] for r in point):.2f}) | {med(point, 'wall_s'):.2f} | – | {med(point, 'process_cpu_s'):.2f} | "
-          f"{med(point, 'rss_gb'):.2f} | length {point[0]['time']:.1f} cells |")
+    def spread(rows):
+        return f"{med(rows, 'cpu_s'):.2f} ({min(r['cpu_s'] for r in rows):.2f}-{max(r['cpu_s'] for r in rows):.2f})"
+
+    print(f"| heat, band auto | {spread(heat)} | {med(heat, 'wall_s'):.2f} | {med(heat, 'field_cpu_s'):.2f} "
+          f"({share:.0%}) | {med(heat, 'process_cpu_s'):.2f} | {med(heat, 'rss_gb'):.2f} | "
+          f"time {heat[0]['time']:.1f} s |")
+    print(f"| point-robot Dijkstra (scipy, free cells) | {spread(point)} | {med(point, 'wall_s'):.2f} | – | "
+          f"{med(point, 'process_cpu_s'):.2f} | {med(point, 'rss_gb'):.2f} | length {point[0]['time']:.1f} cells |")
     print(f"\nheat / baseline, median of the pairwise ratios: CPU {ratio:.2f}, wall {wall_ratio:.2f}.\n")
 
 

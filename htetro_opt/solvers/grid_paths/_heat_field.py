@@ -178,7 +178,8 @@ def _check_choice(value, name: str, choices: tuple[str, ...]) -> str:
 
 
 def _q1_dofs(free: np.ndarray, split: bool) -> tuple[np.ndarray, int]:
-    """Global dof of each corner of each cell, (H, W, 2, 2), before compaction; and the pinches split."""
+    """Global dof of each corner of each cell, (H, W, 2, 2) (the grid nodes, then 4 copies a split
+    pinch); and the number of pinches split."""
     h, w = free.shape
     node = np.arange((h + 1) * (w + 1)).reshape(h + 1, w + 1)
     dofs = np.empty((h, w, 2, 2), dtype=np.int64)
