@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import functools
 import os
+import types
 
 from htetro_opt.errors import DependencyError
 
@@ -94,6 +95,16 @@ def lazy_jit(function=None, *, calls: tuple[str, ...] = ()):
         Names of other module-level functions that ``function`` calls: numba resolves them from
         the module's globals when it compiles, so they are compiled first and rebound there.
 
+    Returns
+    -------
+    callable
+        ``function``, compiled at its first call; ``.py_func`` is ``function`` itself,
+        ``.interpreted(*args)`` runs it (and the functions of ``calls``) in the interpreter, never
+        importing numba, and ``.loaded()`` says whether it has been compiled (or loaded from the cache)
+        in this process. Importing numba and loading a kernel from its cache costs about 0.3 s, more than
+        a small search takes in the interpreter: a caller may run a short job by ``.interpreted`` and
+        hand a long one over to the compiled kernel (the same code, so the same results).
+
     Examples
     --------
     The shortcut's loop search is wrapped at import and compiled when it first runs:
@@ -108,6 +119,7 @@ def lazy_jit(function=None, *, calls: tuple[str, ...] = ()):
     if function is None:
         return functools.partial(lazy_jit, calls=calls)
     compiled = None
+    python = None
 
     @functools.wraps(function)
     def call(*args):
@@ -121,5 +133,17 @@ def lazy_jit(function=None, *, calls: tuple[str, ...] = ()):
             announce_compile(compiled)
         return compiled(*args)
 
+    def interpreted(*args):
+        nonlocal python
+        if python is None:  # the module is whole by now: its constants are all defined
+            scope = dict(function.__globals__)
+            for name in calls:  # the Python versions, also once numba has rebound the module's names
+                scope[name] = getattr(scope[name], "py_func", scope[name])
+            python = types.FunctionType(function.__code__, scope, function.__name__, function.__defaults__,
+                                        function.__closure__)
+        return python(*args)
+
     call.py_func = function  # the Python version, for tests that compare the two
+    call.interpreted = interpreted
+    call.loaded = lambda: compiled is not None
     return call

@@ -50,11 +50,18 @@ __all__ = ["PoseSpace", "heuristic_field", "search_leg", "lazy_bytes", "quantum"
 _STOP = command_id("stop")
 BLOCK = 4096
 """Entries of one block of the bucket queue's pool."""
-_FOUND, _UNREACHABLE, _OVERFLOW, _GROW, _RANGE = 0, 1, 2, 3, 4
+_FOUND, _UNREACHABLE, _OVERFLOW, _GROW, _RANGE, _PAUSE = 0, 1, 2, 3, 4, 5
 _WORD_BITS = 32
 """Bits of a pose's word (cost and parent) in the first try; a cost beyond them restarts the leg with 64."""
 _HEAP_START = 1 << 16
 """Entries the float heap's arrays start with."""
+_INTERPRETED = 15_000
+"""Poses a process expands in the interpreter before the compiled kernel takes the search over. Importing numba
+and loading a kernel from its on-disk cache costs about 0.3 s CPU, the time of some 35,000 expansions in the
+interpreter (8-9 us each; compiled: under 1 us): a search that needs fewer (a 24 x 24 map's A*: 3,000) is done
+without numba, and one that needs more is handed over at this count, having lost at most half of numba's
+start-up. The kernel is the same code either way, resumed where the interpreter paused: the same plan."""
+_interpreted_left = _INTERPRETED
 _MAX_BUCKETS = 4096
 """Most distinct f values ahead of the current one the bucket ring holds (2 * longest command + 2 quanta)."""
 
@@ -287,9 +294,9 @@ def _valid(e, fc, usable, radius, clear, free, sweep_ptr, sweep_off):
 
 
 @lazy_jit(calls=("_valid",))
-def _bucket_search(state, goal, n_sh, w, wf, m, n_commands, usable, target_sh, radius, dx, dy, sweep_ptr,
+def _bucket_kernel(state, goal, n_sh, w, wf, m, n_commands, usable, target_sh, radius, dx, dy, sweep_ptr,
                    sweep_off, free, clear, cost, h, g, unset, pbits, cbits, cap, pool, block_next, head, fill,
-                   free_blocks):
+                   free_blocks, limit):
     """Dial's A* (h = 0: Dijkstra) over integer quanta, resumable.
 
     ``state`` = [status, current f, entries queued, blocks free, poses expanded]; the queue is a ring of
@@ -298,13 +305,17 @@ def _bucket_search(state, goal, n_sh, w, wf, m, n_commands, usable, target_sh, r
     ``free_blocks[:state[3]]``. ``g[pose]`` packs cost << pbits | parent (sh << cbits | command); ``unset``
     is unreached. Returns when the goal is taken (status 0), the queue runs dry (1), a cost exceeds
     ``cap`` (2), fewer free blocks remain than a pose's commands may need (3: grow the pool and call
-    again), or an f would leave the ring (4, impossible with a consistent h).
+    again), an f would leave the ring (4, impossible with a consistent h), or ``limit`` poses have been
+    expanded (5: call again to go on).
     """
     nb = len(head)
     block = len(pool) // len(block_next)
     cur, queued, n_free, expanded = state[1], state[2], state[3], state[4]
     status = _UNREACHABLE_
     while queued > 0:
+        if expanded >= limit:
+            status = _PAUSE_
+            break
         b = cur % nb
         if head[b] < 0:
             cur += 1
@@ -385,17 +396,21 @@ def _sift_down(keys, nodes, size, i):
 
 
 @lazy_jit(calls=("_valid", "_sift_down"))
-def _heap_search(state, goal, n_sh, w, wf, m, n_commands, usable, target_sh, radius, dx, dy, sweep_ptr,
-                 sweep_off, free, clear, cost, h, g, parent, cbits, keys, nodes):
+def _heap_kernel(state, goal, n_sh, w, wf, m, n_commands, usable, target_sh, radius, dx, dy, sweep_ptr,
+                 sweep_off, free, clear, cost, h, g, parent, cbits, keys, nodes, limit):
     """A* (h = 0: Dijkstra) over float64 costs with a binary heap on arrays, resumable.
 
     ``state`` = [status, heap size, poses expanded]; ``g`` is inf where unreached and ``parent[pose]`` is
     sh << cbits | command. Status 0: the goal was taken; 1: the heap ran dry; 3: the heap's arrays
-    may not hold a pose's successors (grow them and call again).
+    may not hold a pose's successors (grow them and call again); 5: ``limit`` poses have been expanded
+    (call again to go on).
     """
     size, expanded = state[1], state[2]
     status = _UNREACHABLE_
     while size > 0:
+        if expanded >= limit:
+            status = _PAUSE_
+            break
         if size + n_commands > len(keys):
             status = _GROW_
             break
@@ -444,7 +459,43 @@ def _heap_search(state, goal, n_sh, w, wf, m, n_commands, usable, target_sh, rad
     state[0], state[1], state[2] = status, size, expanded
 
 
-_FOUND_, _UNREACHABLE_, _OVERFLOW_, _GROW_, _RANGE_ = _FOUND, _UNREACHABLE, _OVERFLOW, _GROW, _RANGE  # numba globals
+_FOUND_, _UNREACHABLE_, _OVERFLOW_, _GROW_, _RANGE_, _PAUSE_ = (  # numba globals
+    _FOUND, _UNREACHABLE, _OVERFLOW, _GROW, _RANGE, _PAUSE)
+
+
+def _bucket_search(*args) -> None:
+    """:func:`_bucket_kernel` (without ``limit``) to its end, by :func:`_run`; ``args[18]`` is ``g``."""
+    _run(_bucket_kernel, args, 4, (18,))
+
+
+def _heap_search(*args) -> None:
+    """:func:`_heap_kernel` (without ``limit``) to its end, by :func:`_run`; ``args[18:20]`` are ``g, parent``."""
+    _run(_heap_kernel, args, 2, (18, 19))
+
+
+def _run(kernel, args, expanded_at: int, kept: tuple[int, ...]) -> None:
+    """``kernel(*args, limit)`` to its end (any status but 5): in the interpreter while the process's budget of
+    :data:`_INTERPRETED` expansions lasts and the kernel has not been loaded, then compiled.
+
+    ``args[0]`` is the kernel's state (poses expanded at ``expanded_at``); the interpreter runs on lists
+    (3 times faster than on numpy's scalars), copied back into the arrays of ``kept`` (those read after the
+    search ends) and, when the search is to go on, into every array.
+    """
+    global _interpreted_left
+    state = args[0]
+    if not kernel.loaded() and _interpreted_left > 0:
+        listed = [a.tolist() if isinstance(a, np.ndarray) else a for a in args]
+        before = int(state[expanded_at])
+        kernel.interpreted(*listed, before + _interpreted_left)
+        status = listed[0][0]
+        resumed = status in (_GROW, _PAUSE)
+        for i, (array, values) in enumerate(zip(args, listed)):
+            if isinstance(array, np.ndarray) and (i == 0 or i in kept or (resumed and array.flags.writeable)):
+                array[:] = values
+        _interpreted_left -= int(state[expanded_at]) - before
+        if status != _PAUSE:
+            return
+    kernel(*args, np.int64(2**62))
 
 
 def _tables(space: PoseSpace):

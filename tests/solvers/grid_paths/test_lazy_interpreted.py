@@ -1,0 +1,109 @@
+"""The graph-free search run in the interpreter, compiled, or begun in one and resumed in the other gives the
+same plan, pose for pose and expansion for expansion; a small plan never imports numba."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from htetro_opt.errors import ConfigurationError
+from htetro_opt.model import Pose, Simulator, Workspace
+from htetro_opt.model.robot import STATE_NAMES
+from htetro_opt.solvers.grid_paths import _exact, _lazy, plan_exact
+
+
+def random_case(seed):
+    """A random map of 8 to 14 cells a side and two random collision-free poses on it."""
+    rng = np.random.default_rng(seed)
+    w, h = (int(v) for v in rng.integers(8, 15, size=2))
+    occ = rng.random((h, w)) < rng.uniform(0.05, 0.25)
+    occ[:5, :5] = occ[-5:, -5:] = False
+    ws = Workspace(occ)
+    sim = Simulator(ws)
+    poses = []
+    while len(poses) < 2:
+        pose = Pose(int(rng.integers(w)), int(rng.integers(h)), STATE_NAMES[int(rng.integers(7))], int(rng.integers(4)))
+        try:
+            sim.check_pose(pose)
+        except ConfigurationError:
+            continue
+        poses.append(pose)
+    return ws, poses
+
+
+def revalidates(plan, ws, roadmap, **compile_options):
+    result = Simulator(ws, **compile_options).run([plan.commands], roadmap[0], roadmap=roadmap[1:])
+    assert result.valid[0] and bool(result.reached[0]) == plan.reached
+    assert result.time[0] == pytest.approx(plan.time) and (result.poses(0) == plan.poses).all()
+
+
+def run(monkeypatch, ws, roadmap, *, interpreted, method="astar", diagonals=False):
+    """A plan with ``interpreted`` expansions in the interpreter first (0: compiled only; None: all)."""
+    for kernel in (_lazy._bucket_kernel, _lazy._heap_kernel):
+        monkeypatch.setattr(kernel, "loaded", lambda: False)  # as in a process that has not loaded numba yet
+    monkeypatch.setattr(_lazy, "_interpreted_left", 10**9 if interpreted is None else interpreted)
+    plan = plan_exact(ws, roadmap, method=method, diagonals=diagonals)
+    left = _lazy._interpreted_left
+    return plan, left
+
+
+def same(a, b):
+    assert a.reached == b.reached and a.time == b.time and a.info == b.info
+    assert np.array_equal(a.commands, b.commands) and np.array_equal(a.poses, b.poses)
+
+
+@pytest.mark.parametrize("method", ["astar", "dijkstra"])
+@pytest.mark.parametrize("diagonals", [False, True])  # the bucket queue, the float heap
+def test_interpreted_compiled_and_handed_over_searches_agree(monkeypatch, method, diagonals):
+    for seed in range(4):
+        ws, roadmap = random_case(seed)
+        compiled, left = run(monkeypatch, ws, roadmap, interpreted=0, method=method, diagonals=diagonals)
+        assert left == 0
+        revalidates(compiled, ws, roadmap, diagonals=diagonals)
+        best = _exact._plan_graph(ws, roadmap, method="dijkstra", diagonals=diagonals, commands=None, timing=None,
+                                  clearance=0.0, t0=0)
+        assert compiled.reached == best.reached and compiled.time == pytest.approx(best.time)
+        expanded = compiled.info["expanded"]
+        plan, left = run(monkeypatch, ws, roadmap, interpreted=None, method=method, diagonals=diagonals)
+        same(plan, compiled)
+        assert left == 10**9 - expanded  # every expansion in the interpreter
+        for k in (1, 7, expanded // 2):  # handed over to the compiled kernel after k expansions
+            plan, left = run(monkeypatch, ws, roadmap, interpreted=k, method=method, diagonals=diagonals)
+            same(plan, compiled)
+            assert left == (0 if expanded > k else k - expanded)
+
+
+def test_the_queue_grows_in_the_interpreter_too(monkeypatch):
+    ws = Workspace(np.zeros((12, 12), dtype=bool))
+    roadmap = [Pose(1, 1, "O", 0), Pose(9, 8, "L", 2)]
+    monkeypatch.setattr(_lazy, "BLOCK", 2)  # a pool of 64 blocks of 2 entries: the frontier outgrows it
+    grown = []
+    original = _lazy._run
+
+    def spy(kernel, args, *rest):
+        original(kernel, args, *rest)
+        grown.append(int(args[0][0]))
+
+    monkeypatch.setattr(_lazy, "_run", spy)
+    compiled, _ = run(monkeypatch, ws, roadmap, interpreted=0, method="dijkstra")
+    assert grown.count(_lazy._GROW) >= 1
+    for k in (None, 50):
+        grown.clear()
+        plan, _ = run(monkeypatch, ws, roadmap, interpreted=k, method="dijkstra")
+        same(plan, compiled)
+        assert grown.count(_lazy._GROW) >= 1
+
+
+_SMALL_PLAN = """
+import sys
+from htetro_opt.cli import main
+main(["plan", "three_slit", "--json"])
+print(sorted(m for m in ("numba", "scipy.sparse", "scipy.ndimage") if m in sys.modules))
+"""
+
+
+def test_a_small_plan_does_not_import_numba():
+    out = subprocess.run([sys.executable, "-c", _SMALL_PLAN], capture_output=True, text=True, check=True).stdout
+    assert '"reached": true' in out
+    assert "numba" not in out.splitlines()[-1]
