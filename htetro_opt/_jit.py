@@ -6,7 +6,10 @@ these loops. A loop wrapped by :func:`lazy_jit` is compiled (``cache=True``: lat
 from numba's on-disk cache) the first time it is called. The modules made of compiled kernels
 (``ils``'s, the tiler's sweep), imported only when they run, take numba from :func:`require_numba`
 when they are imported. There is no pure-Python fallback: without numba these raise a
-:class:`~htetro_opt.errors.DependencyError` that says how to install it.
+:class:`~htetro_opt.errors.DependencyError` that says how to install it. (The exact planner runs its first
+expansions by a kernel's ``.interpreted``, the same code in the interpreter, because importing numba and
+loading a kernel costs more than a small search: a 24 x 24 map's plan then never imports numba; a longer
+search is handed over to the compiled kernel, and needs numba.)
 
 A first compile (a fresh install, or after an upgrade) takes seconds; :func:`on_compile` lets the command
 line say so, once, rather than seem to hang.

@@ -38,8 +38,6 @@ import time as _time
 from typing import Sequence
 
 import numpy as np
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
 
 from htetro_opt._validation import check_int
 from htetro_opt.errors import ParameterError, PlanningError
@@ -185,7 +183,7 @@ class _Graph:
         self.usable = usable
         if (sim.durations[:c] <= 0).any() and usable[:, sim.durations[:c] <= 0].any():
             raise PlanningError("exact planning needs every command that moves the robot to take a positive time")
-        self._matrix: csr_matrix | None = None
+        self._matrix = None  # a scipy.sparse.csr_matrix, imported when it is built: a static map's plan needs none
 
     def _colliding_columns(self) -> list[tuple[int, int]]:
         """Pairs (cheaper, costlier) of local commands that lead some pose to the same next pose."""
@@ -212,9 +210,12 @@ class _Graph:
         usable[keys // columns, keys % columns] = False
         return usable
 
-    def matrix(self) -> csr_matrix:
-        """The whole graph: node = phase * n_poses + pose, one edge per usable (pose, command)."""
+    def matrix(self):
+        """The whole graph (a scipy.sparse.csr_matrix): node = phase * n_poses + pose, one edge per usable (pose,
+        command)."""
         if self._matrix is None:
+            from scipy.sparse import csr_matrix
+
             sim = self.sim
             period, n = self.period, sim.n_poses
             weights = (np.broadcast_to(sim.durations[: sim.n_commands], self.target.shape) if self.weights is None
@@ -252,6 +253,8 @@ def _dijkstra_leg(graph: _Graph, start: int, goal: int, t0: int) -> list[int] | 
     sim = graph.sim
     period, n = graph.period, sim.n_poses
     source = (t0 % period) * n + start
+    from scipy.sparse.csgraph import dijkstra
+
     dist, pred = dijkstra(graph.matrix(), indices=source, return_predecessors=True)
     goal_nodes = goal + n * np.arange(period)
     best = goal_nodes[np.argmin(dist[goal_nodes])]

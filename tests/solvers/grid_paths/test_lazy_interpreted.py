@@ -1,8 +1,5 @@
 """The graph-free search run in the interpreter, compiled, or begun in one and resumed in the other gives the
-same plan, pose for pose and expansion for expansion; a small plan never imports numba."""
-
-import subprocess
-import sys
+same plan, pose for pose and expansion for expansion; the small maps' distances, without scipy, are scipy's."""
 
 import numpy as np
 import pytest
@@ -95,15 +92,33 @@ def test_the_queue_grows_in_the_interpreter_too(monkeypatch):
         assert grown.count(_lazy._GROW) >= 1
 
 
-_SMALL_PLAN = """
-import sys
-from htetro_opt.cli import main
-main(["plan", "three_slit", "--json"])
-print(sorted(m for m in ("numba", "scipy.sparse", "scipy.ndimage") if m in sys.modules))
-"""
+def test_the_small_maps_distances_are_scipys():
+    from scipy.ndimage import distance_transform_cdt
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
 
+    from htetro_opt.model.workspace import _breadth_first, grid_distance
 
-def test_a_small_plan_does_not_import_numba():
-    out = subprocess.run([sys.executable, "-c", _SMALL_PLAN], capture_output=True, text=True, check=True).stdout
-    assert '"reached": true' in out
-    assert "numba" not in out.splitlines()[-1]
+    rng = np.random.default_rng(5)
+    for trial in range(40):
+        h, w = (int(v) for v in rng.integers(1, 30, size=2))
+        free = rng.random((h, w)) > rng.uniform(0.0, 0.6)
+        m = int(rng.integers(1, 4))
+        framed = np.zeros((h + 2 * m, w + 2 * m), dtype=np.uint8)
+        framed[m : m + h, m : m + w] = free
+        want = np.minimum(distance_transform_cdt(framed, metric="chessboard"), 255)
+        assert np.array_equal(_lazy._chessboard_by_erosion(framed), want), trial
+        if not free.any():
+            continue
+        gy, gx = (int(v[0]) for v in np.nonzero(free))
+        index = np.arange(h * w).reshape(h, w)  # the 4-connected graph, as scipy's Dijkstra sees it
+        right, up = free[:, :-1] & free[:, 1:], free[:-1] & free[1:]
+        rows = np.concatenate([index[:, :-1][right], index[:-1][up]])
+        cols = np.concatenate([index[:, 1:][right], index[1:][up]])
+        graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(h * w, h * w)).tocsr()
+        want = dijkstra(graph, directed=False, indices=int(index[gy, gx])).reshape(h, w)
+        assert np.array_equal(_breadth_first(free, gx, gy), want), trial
+        assert np.array_equal(grid_distance(Workspace(~free), (gx, gy)), want), trial
+    open_map = np.zeros((600, 600), dtype=np.uint8)  # beyond 255: saturated as the planner saturates scipy's
+    open_map[1:-1, 1:-1] = 1
+    assert int(_lazy._chessboard_by_erosion(open_map).max()) == 255
