@@ -23,8 +23,9 @@ import types
 
 from htetro_opt.errors import DependencyError
 
-__all__ = ["announce_compile", "lazy_jit", "on_compile", "require_numba"]
+__all__ = ["announce_compile", "kernels", "lazy_jit", "on_compile", "require_numba"]
 
+_dispatched: list = []  # the numba functions lazy_jit has made in this process (for kernels())
 _notice = None  # the command line's: says once that kernels are being compiled (display only, never results)
 
 
@@ -86,6 +87,22 @@ def announce_compile(dispatcher) -> None:
                "the next runs)")
 
 
+def kernels() -> list:
+    """Every numba function of htetro-opt made in this process so far: those :func:`lazy_jit` compiled or loaded,
+    the functions they call, and those of the kernel modules imported (each has ``stats.cache_hits`` and
+    ``stats.cache_misses``: loads from numba's on-disk cache and compiles, per signature)."""
+    import sys
+
+    if "numba" not in sys.modules:
+        return []
+    dispatcher = require_numba().core.registry.CPUDispatcher
+    found = {id(d): d for d in _dispatched}
+    for name, module in list(sys.modules.items()):
+        if name.startswith("htetro_opt") and module is not None:
+            found.update((id(v), v) for v in vars(module).values() if isinstance(v, dispatcher))
+    return list(found.values())
+
+
 def lazy_jit(function=None, *, calls: tuple[str, ...] = ()):
     """``function`` compiled by numba on its first call.
 
@@ -133,6 +150,7 @@ def lazy_jit(function=None, *, calls: tuple[str, ...] = ()):
                 if not isinstance(function.__globals__[name], dispatcher):  # shared by two kernels: compiled once
                     function.__globals__[name] = _njit(function.__globals__[name])
             compiled = _njit(function)
+            _dispatched.append(compiled)
             announce_compile(compiled)
         return compiled(*args)
 
