@@ -1,4 +1,4 @@
-"""``python -m htetro_opt.warmup``: a first run in a fresh install compiles and says so; a later process compiles
+"""``python -m htetro_opt.cli.warmup``: a first run in a fresh install compiles and says so; a later process compiles
 nothing and loads every kernel it runs from numba's on-disk cache."""
 
 import os
@@ -9,12 +9,12 @@ import sys
 import pytest
 
 from htetro_opt.errors import ParameterError
-from htetro_opt.warmup import warm_up
+from htetro_opt.cli.warmup import warm_up
 
 
 def test_a_first_warm_up_compiles_and_says_so_a_second_compiles_nothing(tmp_path):
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba"), "HTETRO_OPT_CACHE_DIR": str(tmp_path / "ours")}
-    runs = [subprocess.run([sys.executable, "-m", "htetro_opt.warmup", "plan"], capture_output=True, text=True,
+    runs = [subprocess.run([sys.executable, "-m", "htetro_opt.cli.warmup", "plan"], capture_output=True, text=True,
                            check=True, env=env) for _ in range(2)]
     counts = [tuple(int(v) for v in re.fullmatch(r"kernels: (\d+) compiled, (\d+) loaded from numba's on-disk cache",
                                                   r.stdout.strip()).groups()) for r in runs]

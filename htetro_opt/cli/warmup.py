@@ -1,4 +1,4 @@
-"""Compile ahead: ``python -m htetro_opt.warmup [plan] [sequence]`` fills the on-disk caches once, after an
+"""Compile ahead: ``python -m htetro_opt.cli.warmup [plan] [sequence]`` fills the on-disk caches once, after an
 install or an upgrade, so that no later command compiles.
 
 htetro-opt's hot loops are numba kernels compiled on their first call and kept on disk by numba
