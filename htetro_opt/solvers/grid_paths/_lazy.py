@@ -41,7 +41,7 @@ from htetro_opt._jit import lazy_jit
 from htetro_opt.errors import ConfigurationError, PlanningError
 from htetro_opt.model.commands import command_id
 from htetro_opt.model.robot import N_HEADINGS, Pose, as_pose
-from htetro_opt.model.simulate import _pose_id, _resolve_commands, _states_of
+from htetro_opt.model.simulate import _pose_id, _resolve_commands, _states_of, memory_budget
 from htetro_opt.model.sweeps import SweepTables, sweep_tables
 from htetro_opt.model.workspace import Workspace, describe_cells, grid_distance
 
@@ -62,6 +62,15 @@ interpreter (8-9 us each; compiled: under 1 us): a search that needs fewer (a 24
 without numba, and one that needs more is handed over at this count, having lost at most half of numba's
 start-up. The kernel is the same code either way, resumed where the interpreter paused: the same plan."""
 _interpreted_left = _INTERPRETED
+_INTERPRETED_POSES = 2**15
+"""The largest pose space searched in the interpreter (a 34 x 34 map with the default commands: the papers'
+24 x 24 maps have 16,128 poses); a larger one is searched compiled from the start. The interpreter's lists
+take 8 bytes an entry and 32 more for each distinct value (the search's own arrays 4)."""
+_INTERPRETED_BYTES = 16 * 2**20
+"""Most bytes the interpreter's lists add to :func:`lazy_bytes` within :data:`_INTERPRETED_POSES` (measured
+by tracemalloc: at most 3.9 MiB, on a 34 x 34 map whose search reaches every pose, tested in
+tests/solvers/grid_paths/test_lazy_interpreted.py); where the memory budget leaves less room, the search is
+compiled."""
 _MAX_BUCKETS = 4096
 """Most distinct f values ahead of the current one the bucket ring holds (2 * longest command + 2 quanta)."""
 
@@ -490,19 +499,20 @@ _FOUND_, _UNREACHABLE_, _OVERFLOW_, _GROW_, _RANGE_, _PAUSE_ = (  # numba global
     _FOUND, _UNREACHABLE, _OVERFLOW, _GROW, _RANGE, _PAUSE)
 
 
-def _bucket_search(*args) -> None:
+def _bucket_search(*args, interpret: bool = False) -> None:
     """:func:`_bucket_kernel` (without ``limit``) to its end, by :func:`_run`; ``args[18]`` is ``g``."""
-    _run(_bucket_kernel, args, 4, (18,))
+    _run(_bucket_kernel, args, 4, (18,), interpret)
 
 
-def _heap_search(*args) -> None:
+def _heap_search(*args, interpret: bool = False) -> None:
     """:func:`_heap_kernel` (without ``limit``) to its end, by :func:`_run`; ``args[18:20]`` are ``g, parent``."""
-    _run(_heap_kernel, args, 2, (18, 19))
+    _run(_heap_kernel, args, 2, (18, 19), interpret)
 
 
-def _run(kernel, args, expanded_at: int, kept: tuple[int, ...]) -> None:
-    """``kernel(*args, limit)`` to its end (any status but 5): in the interpreter while the process's budget of
-    :data:`_INTERPRETED` expansions lasts and the kernel has not been loaded, then compiled.
+def _run(kernel, args, expanded_at: int, kept: tuple[int, ...], interpret: bool) -> None:
+    """``kernel(*args, limit)`` to its end (any status but 5): if ``interpret`` (a pose space of at most
+    :data:`_INTERPRETED_POSES` whose lists fit the memory budget), in the interpreter while the process's
+    budget of :data:`_INTERPRETED` expansions lasts and the kernel has not been loaded; then compiled.
 
     ``args[0]`` is the kernel's state (poses expanded at ``expanded_at``); the interpreter runs on lists
     (3 times faster than on numpy's scalars), copied back into the arrays of ``kept`` (those read after the
@@ -510,7 +520,7 @@ def _run(kernel, args, expanded_at: int, kept: tuple[int, ...]) -> None:
     """
     global _interpreted_left
     state = args[0]
-    if not kernel.loaded() and _interpreted_left > 0:
+    if interpret and not kernel.loaded() and _interpreted_left > 0:
         listed = [a.tolist() if isinstance(a, np.ndarray) else a for a in args]
         before = int(state[expanded_at])
         kernel.interpreted(*listed, before + _interpreted_left)
@@ -546,12 +556,14 @@ def search_leg(space: PoseSpace, start: int, goal: int, *, astar: bool) -> tuple
     # Inside the search a pose is cell * n_sh + sh: a cell's poses are neighbours in memory, so a pose's
     # successors (same cell, or the next cell) mostly share its cache lines.
     start, goal = (space.internal(p) for p in (start, goal))
+    interpret = space.n_poses <= _INTERPRETED_POSES and (
+        memory_budget() >= lazy_bytes(space.n_poses, space.n_cells, space.durations, q) + _INTERPRETED_BYTES)
     if q is not None:
-        return _bucket_leg(space, start, goal, field, q, index)
-    return _heap_leg(space, start, goal, field, index)
+        return _bucket_leg(space, start, goal, field, q, index, interpret)
+    return _heap_leg(space, start, goal, field, index, interpret)
 
 
-def _bucket_leg(space, start, goal, field, q, index):
+def _bucket_leg(space, start, goal, field, q, index, interpret=False):
     cost = np.rint(space.durations / q).astype(np.int64)
     # floor(h / q) of a consistent h is consistent with integer costs: floor(a) <= floor(b + c) = floor(b) + c
     h = np.where(np.isfinite(field), np.floor(field / q * (1 - 1e-12) + 1e-9), -1).astype(np.int64).ravel()
@@ -566,7 +578,7 @@ def _bucket_leg(space, start, goal, field, q, index):
             unset, cap = 2**32 - 1, (((1 << _WORD_BITS) - 1) >> space.pbits) - 1
         g[start] = 0
         n_blocks = max(2 * n_buckets, 64)
-        pool = np.empty(n_blocks * BLOCK, dtype=index)
+        pool = np.zeros(n_blocks * BLOCK, dtype=index)  # zeros: one shared int in the interpreter's list
         block_next = np.full(n_blocks, -1, dtype=np.int64)
         head = np.full(n_buckets, -1, dtype=np.int64)
         fill = np.zeros(n_buckets, dtype=np.int64)
@@ -578,7 +590,7 @@ def _bucket_leg(space, start, goal, field, q, index):
         state = np.array([_UNREACHABLE, f0, 1, n_blocks - 1, 0], dtype=np.int64)
         while True:
             _bucket_search(state, goal, *_tables(space), cost, h, g, unset, space.pbits, space.cbits, cap, pool,
-                           block_next, head, fill, free_blocks)
+                           block_next, head, fill, free_blocks, interpret=interpret)
             if state[0] != _GROW:
                 break
             grown = max(n_blocks // 2, 64)  # the pool grows by half: numpy arrays, seen by tracemalloc
@@ -600,7 +612,7 @@ def _bucket_leg(space, start, goal, field, q, index):
     return _walk_back(space, start, goal, lambda p: int(g[p]) & mask, cmask), int(state[4])
 
 
-def _heap_leg(space, start, goal, field, index):
+def _heap_leg(space, start, goal, field, index, interpret=False):
     h = (field * (1 - 1e-12)).ravel()
     g = np.full(space.n_poses, np.inf)
     parent = np.zeros(space.n_poses, dtype=np.uint16)
@@ -610,7 +622,8 @@ def _heap_leg(space, start, goal, field, index):
     keys[0], nodes[0] = h[start // space.n_sh], start
     state = np.array([_UNREACHABLE, 1, 0], dtype=np.int64)
     while True:
-        _heap_search(state, goal, *_tables(space), space.durations, h, g, parent, space.cbits, keys, nodes)
+        _heap_search(state, goal, *_tables(space), space.durations, h, g, parent, space.cbits, keys, nodes,
+                     interpret=interpret)
         if state[0] != _GROW:
             break
         keys = np.concatenate([keys, np.empty(len(keys) // 2)])

@@ -122,3 +122,44 @@ def test_the_small_maps_distances_are_scipys():
     open_map = np.zeros((600, 600), dtype=np.uint8)  # beyond 255: saturated as the planner saturates scipy's
     open_map[1:-1, 1:-1] = 1
     assert int(_lazy._chessboard_by_erosion(open_map).max()) == 255
+
+
+def walled_in(side=28):
+    """A map whose goal room no shape can enter: Dijkstra's search reaches every other pose (its worst case),
+    with 21,952 poses, within _INTERPRETED_POSES (the figure of _INTERPRETED_BYTES is the 34 x 34 map's)."""
+    occ = np.zeros((side, side), dtype=bool)
+    occ[side - 14 : side - 4, side - 14 : side - 4] = True
+    occ[side - 11 : side - 7, side - 11 : side - 7] = False
+    return Workspace(occ), [Pose(2, 2, "O", 0), Pose(side - 10, side - 10, "O", 0)]
+
+
+def test_the_interpreters_lists_stay_within_the_estimate_and_the_budget(monkeypatch):
+    import tracemalloc
+
+    ws, roadmap = walled_in()
+    space = _lazy.PoseSpace.build(ws)
+    assert space.n_poses <= _lazy._INTERPRETED_POSES
+    run(monkeypatch, Workspace(np.zeros((8, 8), dtype=bool)), [Pose(2, 2, "O", 0), Pose(4, 4, "O", 0)],
+        interpreted=None, method="dijkstra")  # the first call's imports and tables, outside the trace
+    monkeypatch.setattr(_lazy, "_interpreted_left", 10**9)
+    tracemalloc.start()
+    try:
+        plan = plan_exact(ws, roadmap, method="dijkstra")
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert not plan.reached and _lazy._interpreted_left == 10**9 - plan.info["expanded"]  # all interpreted
+    assert peak <= _lazy.lazy_bytes(space.n_poses, space.n_cells, space.durations) + _lazy._INTERPRETED_BYTES
+    # a budget with no room for the lists: compiled from the start, the same search
+    tight = _lazy.lazy_bytes(space.n_poses, space.n_cells, space.durations) + _lazy._INTERPRETED_BYTES // 2
+    monkeypatch.setattr(_lazy, "_interpreted_left", 10**9)
+    compiled = plan_exact(ws, roadmap, method="dijkstra", memory_budget=tight)
+    assert _lazy._interpreted_left == 10**9
+    same(compiled, plan)
+
+
+def test_a_larger_pose_space_is_searched_compiled_from_the_start(monkeypatch):
+    ws = Workspace(np.zeros((40, 40), dtype=bool))  # 44,800 poses
+    roadmap = [Pose(2, 2, "O", 0), Pose(30, 30, "O", 0)]
+    plan, left = run(monkeypatch, ws, roadmap, interpreted=None)
+    assert plan.reached and left == 10**9
