@@ -26,7 +26,8 @@ def test_importing_the_command_line_and_building_its_parser_imports_no_solver_li
     assert modules == []
 
 
-@pytest.mark.parametrize("args", [["plan", "three_slit", "--json"], ["plan", "random", "--method", "dijkstra", "--json"]])
+@pytest.mark.parametrize("args", [["plan", "three_slit", "--json"],
+                                  ["plan", "random", "--method", "dijkstra", "--json"]])
 def test_a_small_exact_plan_imports_neither_numba_nor_scipys_graphs(args):
     modules, printed = imported_after(f"from htetro_opt.cli import main\nmain({args!r})")
     assert json.loads(printed)["reached"] is True

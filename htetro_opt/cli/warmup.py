@@ -16,7 +16,8 @@ the warm-up does the same work ahead, by running small jobs of the commands thro
 
 It prints how many kernels it compiled and how many it loaded from numba's cache: a second warm-up (or
 any later process) compiles none. A small exact plan (a 24 x 24 map) needs none of them: its search runs
-in the interpreter while that is cheaper than starting numba (:data:`~htetro_opt.solvers.grid_paths._lazy._INTERPRETED`).
+in the interpreter while that is cheaper than starting numba
+(:data:`~htetro_opt.solvers.grid_paths._lazy._INTERPRETED`).
 The tiler's compiled sweep (large maps only) compiles at its first use.
 """
 

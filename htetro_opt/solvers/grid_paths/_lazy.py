@@ -12,8 +12,8 @@ swept cells, the next state and heading, B2's shift) and the map, in a loop comp
   (``cell * 28 + state * 4 + heading``: a cell's poses share cache lines). The map is framed by blocked cells
   as wide as the largest sweep, so a command's swept cells are one flat offset each from the pose's cell
   and need no bounds test; a per-cell Chebyshev distance to the nearest blocked cell (one byte, from
-  scipy.ndimage, or numpy's erosions on a small map) proves a command valid at once where its whole sweep lies within that distance, so
-  most commands away from walls are never checked cell by cell.
+  scipy.ndimage, or numpy's erosions on a small map) proves a command valid at once where its whole
+  sweep lies within that distance, so most commands away from walls are never checked cell by cell.
 - **A few bytes a pose.** One unsigned 32-bit word a pose holds both the best known cost and the
   back pointer: the cost in time quanta in the high bits, the parent's (state, heading) and the command
   in the low ones (the parent's cell is the pose's minus the command's shift). A cost too large for the
@@ -27,7 +27,9 @@ swept cells, the next state and heading, B2's shift) and the map, in a loop comp
   searches with h = 0. Both stop when the goal is taken from the queue, so both return the optimum.
 
 The queue's pool is grown from Python when the compiled loop runs short (it returns and is called
-again), so every array of the search is numpy's and ``tracemalloc`` sees it.
+again), so every array of the search is numpy's and ``tracemalloc`` sees it. A process's first
+:data:`_INTERPRETED` expansions on a small pose space run the same kernels in the interpreter
+(:func:`_run`), since importing numba and loading them costs more than a small map's whole search.
 """
 
 from __future__ import annotations
@@ -499,14 +501,16 @@ _FOUND_, _UNREACHABLE_, _OVERFLOW_, _GROW_, _RANGE_, _PAUSE_ = (  # numba global
     _FOUND, _UNREACHABLE, _OVERFLOW, _GROW, _RANGE, _PAUSE)
 
 
-def _bucket_search(*args, interpret: bool = False) -> None:
-    """:func:`_bucket_kernel` (without ``limit``) to its end, by :func:`_run`; ``args[18]`` is ``g``."""
-    _run(_bucket_kernel, args, 4, (18,), interpret)
+def _bucket_search(*args) -> None:
+    """:func:`_bucket_kernel` to its end, by :func:`_run`: its arguments but ``limit``, then whether the
+    interpreter may run it; ``args[18]`` is ``g``."""
+    _run(_bucket_kernel, args[:-1], 4, (18,), args[-1])
 
 
-def _heap_search(*args, interpret: bool = False) -> None:
-    """:func:`_heap_kernel` (without ``limit``) to its end, by :func:`_run`; ``args[18:20]`` are ``g, parent``."""
-    _run(_heap_kernel, args, 2, (18, 19), interpret)
+def _heap_search(*args) -> None:
+    """:func:`_heap_kernel` to its end, by :func:`_run`: its arguments but ``limit``, then whether the interpreter
+    may run it; ``args[18:20]`` are ``g, parent``."""
+    _run(_heap_kernel, args[:-1], 2, (18, 19), args[-1])
 
 
 def _run(kernel, args, expanded_at: int, kept: tuple[int, ...], interpret: bool) -> None:
@@ -590,7 +594,7 @@ def _bucket_leg(space, start, goal, field, q, index, interpret=False):
         state = np.array([_UNREACHABLE, f0, 1, n_blocks - 1, 0], dtype=np.int64)
         while True:
             _bucket_search(state, goal, *_tables(space), cost, h, g, unset, space.pbits, space.cbits, cap, pool,
-                           block_next, head, fill, free_blocks, interpret=interpret)
+                           block_next, head, fill, free_blocks, interpret)
             if state[0] != _GROW:
                 break
             grown = max(n_blocks // 2, 64)  # the pool grows by half: numpy arrays, seen by tracemalloc
@@ -622,8 +626,7 @@ def _heap_leg(space, start, goal, field, index, interpret=False):
     keys[0], nodes[0] = h[start // space.n_sh], start
     state = np.array([_UNREACHABLE, 1, 0], dtype=np.int64)
     while True:
-        _heap_search(state, goal, *_tables(space), space.durations, h, g, parent, space.cbits, keys, nodes,
-                     interpret=interpret)
+        _heap_search(state, goal, *_tables(space), space.durations, h, g, parent, space.cbits, keys, nodes, interpret)
         if state[0] != _GROW:
             break
         keys = np.concatenate([keys, np.empty(len(keys) // 2)])
