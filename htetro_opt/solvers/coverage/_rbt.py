@@ -13,6 +13,12 @@ cover t and then reach the exit)``, g being the most new cells one command adds.
 consistent, so the first state popped at the exit with every target covered is optimal: a search
 that ends within its node budget is a proof (the ``best-first`` addition).
 
+The best-first loop runs compiled (numba, :func:`_astar`: the same states, heap order and expansions as
+the Python loop, which runs where a state's key would not fit 63 bits), and its tables toward an exit
+(:func:`_tables`) are built once per region and exit and shared by the searches from every entry: on a
+64 × 64 map of {O, vI, hI} the DAG prices ~46,000 (entry, exit) pairs of ~1,100 regions, each search
+expanding ~17 states, so the set-up, not the search, was the cost (issue 25).
+
 The paper variant (:func:`search_simple`, :func:`search_inserting`) is Alg. 5 as written: a
 depth-first branch and bound over *simple* paths (no vertex twice: §IV-D's "each vertex is visited
 once", a check Algs. 5–6 lack), moves ordered by new cells, then progress along the sweep; when no
@@ -33,9 +39,11 @@ from __future__ import annotations
 
 import heapq
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
+
+from htetro_opt._jit import lazy_jit
 
 __all__ = ["Region", "RegionResult", "search_region", "greedy_walk", "search_simple", "search_inserting",
            "MAX_INSERTIONS"]
@@ -60,6 +68,34 @@ class Region:
     pred: np.ndarray
     progress: tuple = ()  # per vertex: how far along the sweep its B2 is (the paper variant's move order)
     target_progress: tuple = ()  # per target bit, likewise
+    tables: dict = field(default_factory=dict, repr=False)  # the best-first search's per-exit tables (_tables)
+
+
+def _tables(region: Region, exit: int | None) -> tuple:
+    """The best-first search's tables toward one exit: (the target bits, the distance to the exit per
+    vertex as a list, ``via`` (T, V), the per-vertex bound orders). They depend on the region and the
+    exit only, not on the entry, so they are built once per exit and shared by every entry's search
+    (the DAG prices a region from each of its entry ports to each exit: 8 × 8 searches of one region
+    on a 4-row band of {O, vI, hI}); the orders are filled lazily, per vertex reached."""
+    found = region.tables.get(exit)
+    if found is not None:
+        return found
+    dist, bits, full = region.dist, region.bits, region.full
+    n = len(bits)
+    dexit = dist[:, exit] if exit is not None else np.zeros(n)
+    positions = [t for t in range(full.bit_length()) if full >> t & 1]
+    targets = [1 << t for t in positions]
+    covers = region.tables.get("covers")
+    if covers is None:  # (T, V): vertex v's footprint covers target t
+        covers = region.tables["covers"] = np.array([[b >> t & 1 for b in bits] for t in positions],
+                                                    dtype=bool).reshape(len(positions), n)
+    # via[t][v]: the cheapest way from v to cover target t and then reach the exit (min over its covers c
+    # of dist[v, c] + dexit[c]; inf when no vertex covers t)
+    via = np.where(covers[:, None, :], (dist + dexit[None, :])[None, :, :], np.inf).min(axis=2) if targets \
+        else np.zeros((0, n))
+    order = np.argsort(-via, axis=0, kind="stable").T.tolist() if targets else [[] for _ in range(n)]
+    found = region.tables[exit] = (targets, dexit.tolist(), via, order, {})
+    return found
 
 
 @dataclass(frozen=True)
@@ -109,26 +145,120 @@ def greedy_walk(region: Region, entry: int, exit: int | None) -> RegionResult | 
     return RegionResult(int(round(cost)), tuple(path), False, 0)
 
 
+def _popcount(x):
+    count = 0
+    while x:
+        x &= x - 1
+        count += 1
+    return count
+
+
+@lazy_jit(calls=("_popcount",))
+def _astar(indptr, indices, costs, bits, full, entry, exit, gain, budget, dexit, via, orders, targets, shift):
+    """:func:`search_region`'s A*, compiled: the same states, bound, heap order (numba's heapq is CPython's
+    algorithm) and expansion count as the Python loop it replaces, on arrays (a state (v, mask) is the key
+    ``v << shift | mask``). Returns (status, cost, expansions, path): status 0 found, 1 no covering walk,
+    2 the budget ran out."""
+    n_t = targets.shape[0]
+
+    def bound(v, unc):
+        best = dexit[v]
+        q = -(-_popcount(unc) // gain)
+        if q > best:
+            best = float(q)
+        for k in range(n_t):
+            t = orders[v, k]
+            if unc & targets[t]:
+                value = via[t, v]
+                return value if value > best else best
+        return best
+
+    m0 = bits[entry]
+    k0 = (entry << shift) | m0
+    best_g = {k0: 0}
+    parent = {k0: -1}
+    heap = [(bound(entry, full & ~m0), 0, entry, m0)]
+    expanded = 0
+    mask_of = (1 << shift) - 1
+    while len(heap):
+        f, neg_g, v, mask = heapq.heappop(heap)
+        g = -neg_g
+        key = (v << shift) | mask
+        if best_g[key] < g:
+            continue
+        if mask == full and (exit < 0 or v == exit):
+            path = [v]
+            state = parent[key]
+            while state >= 0:
+                path.append(state >> shift)
+                state = parent[state]
+            return 0, g, expanded, np.array(path[::-1], dtype=np.int64)
+        expanded += 1
+        if expanded > budget:
+            return 2, 0, expanded, np.zeros(0, dtype=np.int64)
+        for i in range(indptr[v], indptr[v + 1]):
+            w = indices[i]
+            m2 = mask | bits[w]
+            g2 = g + costs[i]
+            k2 = (w << shift) | m2
+            if g2 < best_g.get(k2, 1 << 62):
+                h = bound(w, full & ~m2)
+                if h == np.inf:
+                    continue
+                best_g[k2] = g2
+                parent[k2] = key
+                heapq.heappush(heap, (g2 + h, -g2, w, m2))
+    return 1, 0, expanded, np.zeros(0, dtype=np.int64)
+
+
+def _arrays(region: Region) -> tuple | None:
+    """The region as the compiled search's arrays (CSR adjacency in the listed order, bits), or None when
+    a state's key would not fit 63 bits (then the Python loop runs)."""
+    found = region.tables.get("arrays", False)
+    if found is not False:
+        return found
+    n = len(region.bits)
+    shift = max(1, region.full.bit_length())
+    if shift + max(1, n).bit_length() > 62:
+        region.tables["arrays"] = None
+        return None
+    indptr = np.zeros(n + 1, dtype=np.int64)
+    indptr[1:] = np.cumsum([len(a) for a in region.adjacency])
+    flat = [wc for a in region.adjacency for wc in a]
+    indices = np.array([w for w, _ in flat], dtype=np.int64)
+    costs = np.array([c for _, c in flat], dtype=np.int64)
+    found = region.tables["arrays"] = (indptr, indices, costs, np.array(region.bits, dtype=np.int64), shift)
+    return found
+
+
 def search_region(region: Region, entry: int, exit: int | None, *, gain: int, budget: int,
-                  fallback: bool = True) -> RegionResult | None:
+                  fallback: bool = True, compiled: bool = True) -> RegionResult | None:
     """The cheapest walk from ``entry`` covering every target and ending at ``exit`` (anywhere for
     None), by A* over (vertex, covered) with at most ``budget`` expansions; past the budget, the
     greedy walk (``fallback``) or an exhausted result without a walk. None when the exit cannot be
     reached or a target cannot be covered."""
     dist, bits, full = region.dist, region.bits, region.full
-    n = len(bits)
     if exit is not None and not math.isfinite(dist[entry, exit]):
         return None
-    dexit = dist[:, exit] if exit is not None else np.zeros(n)
-    targets = [1 << t for t in range(full.bit_length()) if full >> t & 1]
-    covers = [np.flatnonzero([b & t for b in bits]) for t in targets]
-    # via[t][v]: the cheapest way from v to cover target t and then reach the exit.
-    via = np.array([(dist[:, c] + dexit[c]).min(axis=1) if len(c) else np.full(n, np.inf) for c in covers]) \
-        if targets else np.zeros((0, n))
+    targets, dexit_list, via, orders, lists = _tables(region, exit)[:5]
     if targets and not np.isfinite(via[:, entry]).all():
         return None
-    dexit_list = dexit.tolist()
-    lists: dict[int, list] = {}
+
+    arrays = _arrays(region) if compiled else None
+    if arrays is not None:
+        indptr, indices, costs, bit_array, shift = arrays
+        tables = region.tables[exit]
+        if len(tables) == 5:  # the compiled search's form of the tables, once per exit
+            tables = region.tables[exit] = tables + (
+                np.asarray(dexit_list, dtype=float), np.ascontiguousarray(via, dtype=float),
+                np.array(orders, dtype=np.int64).reshape(len(bits), len(targets)), np.array(targets, dtype=np.int64))
+        status, g, expanded, path = _astar(indptr, indices, costs, bit_array, full, entry, -1 if exit is None else exit,
+                                           gain, budget, *tables[5:], shift)
+        if status == 0:
+            return RegionResult(int(g), tuple(path.tolist()), True, int(expanded))
+        if status == 1:
+            return None
+        return _cut_short(region, entry, exit, int(expanded), fallback)
 
     def bound(v: int, unc: int) -> float:
         best = dexit_list[v]
@@ -137,8 +267,8 @@ def search_region(region: Region, entry: int, exit: int | None, *, gain: int, bu
             best = q
         order = lists.get(v)
         if order is None:
-            column = via[:, v]
-            order = lists[v] = [(float(column[t]), targets[t]) for t in np.argsort(-column, kind="stable")]
+            column = via[:, v].tolist()
+            order = lists[v] = [(column[t], targets[t]) for t in orders[v]]
         for value, bit in order:
             if unc & bit:
                 return value if value > best else best
@@ -178,6 +308,11 @@ def search_region(region: Region, entry: int, exit: int | None, *, gain: int, bu
                 heapq.heappush(heap, (g2 + h, -g2, w, m2))
     if not cut_short:  # searched to the end: no covering walk
         return None
+    return _cut_short(region, entry, exit, expanded, fallback)
+
+
+def _cut_short(region: Region, entry: int, exit: int | None, expanded: int, fallback: bool) -> RegionResult | None:
+    """A best-first search past its budget: the greedy walk (``fallback``), or an exhausted result."""
     if not fallback:
         return RegionResult(0, (), False, expanded, exhausted=True)
     walk = greedy_walk(region, entry, exit)

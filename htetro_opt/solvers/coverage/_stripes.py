@@ -272,7 +272,8 @@ class _Planner:
         self.coverable = cov.coverable.reshape(-1)
         self.memo: dict = {} if shared_memo is None else shared_memo  # keyed by content: safe to share
         self._from: dict | None = None  # shortest paths from a port, (dist, pred), kept while the order is improved
-        self.problems: dict = {}
+        self.problems: dict = {}  # (sweep, chain, block, entry) -> its region problem
+        self.windows: dict = {}  # (sweep, chain, block, window) -> its vertices, their pieces and problems
         self.results: dict = {}
         self.stats = {"regions": 0, "optimal": 0, "memo_hits": 0, "nodes": 0}
         self.time_limited = False
@@ -511,24 +512,48 @@ class _Planner:
     # --- regions ------------------------------------------------------------------------------
     def _problem(self, stripe: _Sweep, layout: tuple[int, int], b: int, entry: int, exits: list[int]):
         """The region problem of block b of a sweep's chain ``layout`` from ``entry``: (nodes, Region,
-        memo key)."""
+        memo key, targets outside the window, local number of each node).
+
+        The problem depends on the entry only through its window (its x widens the window where it lies
+        outside the block's) and the connected piece of the window it is in, so it is built once per
+        (block, window, piece) and shared by the block's entries: every entry port at a cut has the
+        cut's x, and the DAG prices each block from each of them (on tiling_64x64 {O, vI, hI} this was
+        the planner's second cost after the searches)."""
         key = (stripe.key, layout, b, entry)
-        direction, (r0, r1) = stripe.layouts[layout][2][b]
-        if key in self.problems:
-            return self.problems[key]
+        found = self.problems.get(key)
+        if found is not None:
+            return found
         lg = self.lg
         c0, c1 = stripe.layouts[layout][0][b]
         xs = [self.bx[entry]] + [self.bx[e] for e in exits if e >= 0]
         margin = WINDOW_MARGIN if self.fixed else lg.width  # the paper's regions: the whole stripe
-        x0 = min(c0, *xs) - margin
-        x1 = max(c1 - 1, *xs) + margin
-        nodes = stripe.nodes[(self.bx[stripe.nodes] >= x0) & (self.bx[stripe.nodes] <= x1)]
-        if entry not in set(nodes.tolist()):
-            nodes = np.union1d(nodes, [entry])
-        sub = lg.matrix[nodes][:, nodes]
-        _, labels = connected_components(sub, directed=False)
+        x0 = int(min(c0, *xs) - margin)
+        x1 = int(max(c1 - 1, *xs) + margin)
+        window_key = (stripe.key, layout, b, x0, x1)
+        window = self.windows.get(window_key)
+        if window is None:
+            nodes = stripe.nodes[(self.bx[stripe.nodes] >= x0) & (self.bx[stripe.nodes] <= x1)]
+            _, labels = connected_components(lg.matrix[nodes][:, nodes], directed=False)
+            window = self.windows[window_key] = (nodes, labels, {})
+        nodes, labels, pieces = window
         at = int(np.searchsorted(nodes, entry))
-        nodes = nodes[labels == labels[at]]
+        if at < len(nodes) and nodes[at] == entry:
+            piece = int(labels[at])
+        else:  # an entry outside the sweep's vertices (cannot happen for a port): its own window
+            nodes = np.union1d(nodes, [entry])
+            _, labels = connected_components(lg.matrix[nodes][:, nodes], directed=False)
+            nodes, labels, pieces, piece = nodes, labels, {}, int(labels[int(np.searchsorted(nodes, entry))])
+        found = pieces.get(piece)
+        if found is None:
+            found = pieces[piece] = self._build(stripe, layout, b, nodes[labels == piece], x0, x1)
+        self.problems[key] = found
+        return found
+
+    def _build(self, stripe: _Sweep, layout, b: int, nodes: np.ndarray, x0: int, x1: int):
+        """The region problem on a window's connected piece ``nodes`` (see :meth:`_problem`)."""
+        lg = self.lg
+        direction, (r0, r1) = stripe.layouts[layout][2][b]
+        c0, c1 = stripe.layouts[layout][0][b]
         sub = lg.matrix[nodes][:, nodes].tocsr()
         sub.sort_indices()
         tx, ty = stripe.targets % lg.width, stripe.targets // lg.width
@@ -551,8 +576,8 @@ class _Planner:
         progress = tuple((direction * self.bx[nodes]).tolist())
         target_progress = tuple((direction * (reachable_targets % lg.width)).tolist())
         region = Region(adjacency, bits, full, dist, pred, progress, target_progress)
-        self.problems[key] = (nodes, region, memo_key, len(targets) - len(reachable_targets))
-        return self.problems[key]
+        local = {int(v): i for i, v in enumerate(nodes.tolist())}
+        return nodes, region, memo_key, len(targets) - len(reachable_targets), local
 
     def region_cost(self, sweep: _Sweep, layout: tuple[int, int], b: int, entry: int, exit: int,
                     exits: list[int]) -> float | None:
@@ -561,8 +586,7 @@ class _Planner:
         window from that entry (left to the mop-up); None if impossible."""
         key = (sweep.key, layout, b, entry, exit)
         if key not in self.results:
-            nodes, region, memo_key, dropped = self._problem(sweep, layout, b, entry, exits)
-            local = {int(v): i for i, v in enumerate(nodes)}
+            nodes, region, memo_key, dropped, local = self._problem(sweep, layout, b, entry, exits)
             if exit >= 0 and exit not in local:
                 self.results[key] = None
                 return None

@@ -267,6 +267,37 @@ def test_more_budget_never_raises_a_region_cost(n, seed, budget):
     assert small.path[0] == 0 and small.path[-1] == exit
 
 
+
+@settings(max_examples=40, deadline=None)
+@given(n=st.integers(1, 10), seed=st.integers(0, 2**16), budget=st.integers(1, 60), free_end=st.booleans())
+def test_the_compiled_region_search_is_the_python_one(n, seed, budget, free_end):
+    # a random connected window, edges costing 1-3, each vertex covering some of 7 targets: the compiled A*
+    # must give the Python loop's walk, cost, proof and expansions, also when the budget runs out
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    from htetro_opt.solvers.coverage._rbt import Region, search_region
+
+    rng = np.random.default_rng(seed)
+    edges = {(i, int(rng.integers(0, i))) for i in range(1, n)} | {
+        tuple(sorted(map(int, rng.integers(0, n, 2)))) for _ in range(n)}
+    edges = sorted((a, b) for a, b in edges if a != b)
+    cost = {e: int(rng.integers(1, 4)) for e in edges}
+    adjacency = tuple(tuple((b if a == v else a, cost[a, b]) for a, b in edges if v in (a, b)) for v in range(n))
+    bits = tuple(int(rng.integers(0, 128)) for _ in range(n))
+    full = 0
+    for b in bits:
+        full |= b
+    pairs = [(a, b, cost[a, b]) for a, b in edges] + [(b, a, cost[a, b]) for a, b in edges]
+    rows, cols, data = zip(*pairs) if pairs else ((), (), ())
+    dist, pred = dijkstra(csr_matrix((np.array(data, dtype=float), (rows, cols)), shape=(n, n)),
+                          return_predecessors=True)
+    exit = None if free_end else int(rng.integers(0, n))
+    for entry in range(n):
+        found = [search_region(Region(adjacency, bits, full, dist, pred), entry, exit, gain=g, budget=budget,
+                               compiled=compiled) for g in (2, 4) for compiled in (True, False)]
+        assert found[0] == found[1] and found[2] == found[3]
+
 def brute_cheapest(ws, layers, start):
     """Fewest commands from ``start`` until every coverable cell is under a visited layer pose:
     BFS over (simulator pose, covered cells), one command at a time."""
