@@ -3,7 +3,7 @@
 - ``"stripes"``: the paper's graph-theory coverage in our reading: morphology layers
   (:class:`LayerGraph`, Def. 4–5), stripes of rows (Def. 6–7) cut into regions, a best-first branch
   and bound per region (Alg. 5's RBT) and one auxiliary DAG over ports and cut-edges solved by
-  networkx's Dijkstra (Def. 8–10, eq. 8, Alg. 1), then a mop-up of what the stripes left: the
+  a Dijkstra (Def. 8–10, eq. 8, Alg. 1), then a mop-up of what the stripes left: the
   paper's Alg. 5 with our additions (:data:`STRIPES_ADDITIONS`, each switched by ``additions``);
 - ``"stripes-paper"``: Alg. 5 as published, none of them: what it leaves uncovered, and the region
   searches that spend their node budget, are reported (``missed``, ``failed_regions``), not rescued;

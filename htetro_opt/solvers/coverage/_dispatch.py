@@ -58,7 +58,7 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
 
         - ``"stripes"`` (default): stripes of rows, each cut into regions of ``region_columns``
           columns, every region searched for its cheapest covering walk, and one auxiliary DAG
-          (networkx) picking the ports and layers between them (see
+          (Dijkstra) picking the ports and layers between them (see
           ``htetro_opt.solvers.coverage._stripes`` for our reading of the paper);
         - ``"stripes-paper"``: the paper's Alg. 5 as written, none of our additions: regions cut only
           at forced poses (the only pose of the stripe covering some cell), a depth-first search over

@@ -72,11 +72,12 @@ class Region:
 
 
 def _tables(region: Region, exit: int | None) -> tuple:
-    """The best-first search's tables toward one exit: (the target bits, the distance to the exit per
-    vertex as a list, ``via`` (T, V), the per-vertex bound orders). They depend on the region and the
+    """The best-first search's tables toward one exit: (the target bits as a list and an array, the
+    distance to the exit per vertex, ``via`` (T, V), per vertex the targets by decreasing ``via``, and the
+    Python loop's per-vertex bound lists, filled lazily). They depend on the region and the
     exit only, not on the entry, so they are built once per exit and shared by every entry's search
     (the DAG prices a region from each of its entry ports to each exit: 8 × 8 searches of one region
-    on a 4-row band of {O, vI, hI}); the orders are filled lazily, per vertex reached."""
+    on a 4-row band of {O, vI, hI})."""
     found = region.tables.get(exit)
     if found is not None:
         return found
@@ -93,8 +94,11 @@ def _tables(region: Region, exit: int | None) -> tuple:
     # of dist[v, c] + dexit[c]; inf when no vertex covers t)
     via = np.where(covers[:, None, :], (dist + dexit[None, :])[None, :, :], np.inf).min(axis=2) if targets \
         else np.zeros((0, n))
-    order = np.argsort(-via, axis=0, kind="stable").T.tolist() if targets else [[] for _ in range(n)]
-    found = region.tables[exit] = (targets, dexit.tolist(), via, order, {})
+    order = np.ascontiguousarray(np.argsort(-via, axis=0, kind="stable").T)  # (V, T): targets by via, decreasing
+    wide = full.bit_length() > 62  # the compiled search's keys would not fit: the Python loop alone runs
+    found = region.tables[exit] = (targets, None if wide else np.array(targets, dtype=np.int64),
+                                   np.ascontiguousarray(dexit, dtype=float),
+                                   np.ascontiguousarray(via, dtype=float), order.astype(np.int64), {})
     return found
 
 
@@ -240,25 +244,20 @@ def search_region(region: Region, entry: int, exit: int | None, *, gain: int, bu
     dist, bits, full = region.dist, region.bits, region.full
     if exit is not None and not math.isfinite(dist[entry, exit]):
         return None
-    targets, dexit_list, via, orders, lists = _tables(region, exit)[:5]
+    targets, target_array, dexit, via, orders, lists = _tables(region, exit)
     if targets and not np.isfinite(via[:, entry]).all():
         return None
-
     arrays = _arrays(region) if compiled else None
     if arrays is not None:
         indptr, indices, costs, bit_array, shift = arrays
-        tables = region.tables[exit]
-        if len(tables) == 5:  # the compiled search's form of the tables, once per exit
-            tables = region.tables[exit] = tables + (
-                np.asarray(dexit_list, dtype=float), np.ascontiguousarray(via, dtype=float),
-                np.array(orders, dtype=np.int64).reshape(len(bits), len(targets)), np.array(targets, dtype=np.int64))
         status, g, expanded, path = _astar(indptr, indices, costs, bit_array, full, entry, -1 if exit is None else exit,
-                                           gain, budget, *tables[5:], shift)
+                                           gain, budget, dexit, via, orders, target_array, shift)
         if status == 0:
             return RegionResult(int(g), tuple(path.tolist()), True, int(expanded))
         if status == 1:
             return None
         return _cut_short(region, entry, exit, int(expanded), fallback)
+    dexit_list = dexit.tolist()
 
     def bound(v: int, unc: int) -> float:
         best = dexit_list[v]
@@ -268,7 +267,7 @@ def search_region(region: Region, entry: int, exit: int | None, *, gain: int, bu
         order = lists.get(v)
         if order is None:
             column = via[:, v].tolist()
-            order = lists[v] = [(column[t], targets[t]) for t in orders[v]]
+            order = lists[v] = [(column[t], targets[t]) for t in orders[v].tolist()]
         for value, bit in order:
             if unc & bit:
                 return value if value > best else best

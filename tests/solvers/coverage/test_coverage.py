@@ -592,3 +592,34 @@ def test_sequenced_mop_up_beats_nearest_first_on_a_known_map():
     assert (nearest.mopup_commands, sequenced.mopup_commands) == (44, 39)
     assert sequenced.action_cost == nearest.action_cost - 5
     assert (sequenced.covered == nearest.covered).all()
+
+
+@settings(max_examples=40, deadline=None)
+@given(n=st.integers(2, 12), seed=st.integers(0, 2**16))
+def test_the_dags_dijkstra_is_networkxs(n, seed):
+    # random DAGs with many equal-cost paths and hidden edges: the same distance and the same path as networkx
+    import networkx as nx
+
+    from htetro_opt.solvers.coverage._stripes import _Dag
+
+    rng = np.random.default_rng(seed)
+    ours, theirs = _Dag(), nx.DiGraph()
+    for u in range(n):
+        for v in range(u + 1, n):
+            if rng.random() < 0.5:
+                w = int(rng.integers(0, 3))
+                ours.add_edge(u, v, w=w)
+                theirs.add_edge(u, v, w=w)
+
+    def weight(u, v, d):
+        return None if d["w"] == 2 and (u + v) % 3 == 0 else d["w"]
+
+    assert ours.number_of_edges() == theirs.number_of_edges()
+    if 0 not in theirs or n - 1 not in theirs:
+        return
+    found = ours.shortest_path(0, n - 1, weight)
+    try:
+        expected = nx.single_source_dijkstra(theirs, 0, n - 1, weight=weight)
+    except nx.NetworkXNoPath:
+        expected = None
+    assert found == (None if expected is None else (expected[0], expected[1]))
