@@ -45,7 +45,7 @@ import numpy as np
 
 from htetro_opt._jit import lazy_jit
 
-__all__ = ["Region", "RegionResult", "search_region", "greedy_walk", "search_simple", "search_inserting",
+__all__ = ["Region", "RegionResult", "search_region", "greedy_walk", "LazyDistances", "search_simple", "search_inserting",
            "MAX_INSERTIONS"]
 
 MAX_INSERTIONS = 8
@@ -74,7 +74,8 @@ class Region:
 def _tables(region: Region, exit: int | None) -> tuple:
     """The best-first search's tables toward one exit: (the target bits as a list and an array, the
     distance to the exit per vertex, ``via`` (T, V), per vertex the targets by decreasing ``via``, and the
-    Python loop's per-vertex bound lists, filled lazily). They depend on the region and the
+    Python loop's per-vertex bound lists, filled lazily, and per vertex whether every target can be covered
+    from it). They depend on the region and the
     exit only, not on the entry, so they are built once per exit and shared by every entry's search
     (the DAG prices a region from each of its entry ports to each exit: 8 × 8 searches of one region
     on a 4-row band of {O, vI, hI})."""
@@ -98,7 +99,8 @@ def _tables(region: Region, exit: int | None) -> tuple:
     wide = full.bit_length() > 62  # the compiled search's keys would not fit: the Python loop alone runs
     found = region.tables[exit] = (targets, None if wide else np.array(targets, dtype=np.int64),
                                    np.ascontiguousarray(dexit, dtype=float),
-                                   np.ascontiguousarray(via, dtype=float), order.astype(np.int64), {})
+                                   np.ascontiguousarray(via, dtype=float), order.astype(np.int64), {},
+                                   np.isfinite(via).all(axis=0).tolist())
     return found
 
 
@@ -114,25 +116,78 @@ class RegionResult:
 
 def _segment(region: Region, a: int, b: int) -> list[int]:
     """The shortest path a → b in the window, a first."""
-    path = [b]
+    path, pred = [b], region.pred[a]
     while path[-1] != a:
-        path.append(int(region.pred[a, path[-1]]))
+        path.append(int(pred[path[-1]]))
     return path[::-1]
 
 
 def greedy_walk(region: Region, entry: int, exit: int | None) -> RegionResult | None:
     """From the entry, go to the nearest vertex covering an uncovered target (ties: more new targets,
-    then the lower number), until all are covered; then to the exit. None if the exit is unreachable."""
-    dist, bits = region.dist, region.bits
-    if exit is not None and not math.isfinite(dist[entry, exit]):
+    then the lower number), until all are covered; then to the exit. None if the exit is unreachable.
+
+    The covering part does not depend on the exit: it is walked once per entry and kept on the region
+    (a time limit prices every remaining (entry, exit) pair of a region by this walk)."""
+    dist = region.dist
+    if exit is not None and not math.isfinite(dist[entry][exit]):
         return None
+    cover = region.tables.get(("greedy", entry), False)
+    if cover is False:
+        cover = region.tables[("greedy", entry)] = _greedy_cover(region, entry)
+    if cover is None:
+        return None
+    cur, path, cost = cover
+    if exit is not None and exit != cur:
+        path = path + tuple(_segment(region, cur, exit)[1:])
+        cost += dist[cur][exit]
+    return RegionResult(int(round(cost)), path, False, 0)
+
+
+class LazyDistances:
+    """A window's shortest paths computed one source at a time, on demand: ``dist[a]`` / ``pred[a]`` (rows)
+    and ``dist[a, b]`` as the all-pairs arrays give them (the same rows: scipy's Dijkstra per source).
+    For a region only walked greedily (a time limit): the walk needs a few sources, not all of them."""
+
+    __slots__ = ("graph", "rows", "dist", "pred")
+
+    def __init__(self, graph) -> None:
+        self.graph, self.rows = graph, {}
+        self.dist, self.pred = _Rows(self, 0), _Rows(self, 1)
+
+    def row(self, a: int) -> tuple:
+        found = self.rows.get(a)
+        if found is None:
+            from scipy.sparse.csgraph import dijkstra
+
+            found = self.rows[a] = dijkstra(self.graph, indices=int(a), return_predecessors=True)
+        return found
+
+
+class _Rows:
+    __slots__ = ("of", "which")
+
+    def __init__(self, of: LazyDistances, which: int) -> None:
+        self.of, self.which = of, which
+
+    def __getitem__(self, key):
+        if isinstance(key, tuple):
+            a, b = key
+            return self.of.row(a)[self.which][b]
+        return self.of.row(key)[self.which]
+
+
+def _greedy_cover(region: Region, entry: int) -> tuple | None:
+    """:func:`greedy_walk`'s covering part: (where it ends, its vertices, its cost), None if a target is
+    out of reach."""
+    dist, bits = region.dist, region.bits
     cur, mask, path, cost = entry, bits[entry], [entry], 0.0
     while mask != region.full:
         unc = region.full & ~mask
         best = None
+        row = dist[cur].tolist()
         for u, b in enumerate(bits):
-            if b & unc and math.isfinite(dist[cur, u]):
-                key = (dist[cur, u], -(b & unc).bit_count(), u)
+            if b & unc and math.isfinite(row[u]):
+                key = (row[u], -(b & unc).bit_count(), u)
                 if best is None or key < best:
                     best = key
         if best is None:
@@ -141,12 +196,9 @@ def greedy_walk(region: Region, entry: int, exit: int | None) -> RegionResult | 
         for w in _segment(region, cur, u)[1:]:
             mask |= bits[w]
             path.append(w)
-        cost += dist[cur, u]
+        cost += row[u]
         cur = u
-    if exit is not None and exit != cur:
-        path += _segment(region, cur, exit)[1:]
-        cost += dist[cur, exit]
-    return RegionResult(int(round(cost)), tuple(path), False, 0)
+    return cur, tuple(path), cost
 
 
 def _popcount(x):
@@ -244,8 +296,8 @@ def search_region(region: Region, entry: int, exit: int | None, *, gain: int, bu
     dist, bits, full = region.dist, region.bits, region.full
     if exit is not None and not math.isfinite(dist[entry, exit]):
         return None
-    targets, target_array, dexit, via, orders, lists = _tables(region, exit)
-    if targets and not np.isfinite(via[:, entry]).all():
+    targets, target_array, dexit, via, orders, lists, coverable = _tables(region, exit)
+    if not coverable[entry]:  # some target cannot be covered (and the exit then reached) from the entry
         return None
     arrays = _arrays(region) if compiled else None
     if arrays is not None:

@@ -22,8 +22,9 @@ STRIPES_ADDITIONS = {
                   "consistent bound that proves the optimum; the paper's Alg. 5 is a depth-first search over simple "
                   "paths that inserts a pose as a cut when no simple path covers the region",
     "greedy-fallback": "a region search that spends its node budget (or runs past the time limit) takes its best "
-                       "walk so far, or the greedy walk; the paper's search has no budget, so without it the region "
-                       "fails and the result lists it",
+                       "walk so far, or the greedy walk (past the time limit only one chain of each sweep is priced, "
+                       "each region from its entry to the exit nearest where its greedy walk ends); the paper's "
+                       "search has no budget, so without it the region fails and the result lists it",
     "split-sweeps": "a stripe a wall splits into pieces is also planned piece by piece, the pieces joined by transit "
                     "legs, and the cheaper plan kept; the paper widens it until one piece covers it (Alg. 5 l. 14)",
     "sweep-order": "the order and directions of the sweeps are improved by moving or reversing one at a time while "

@@ -67,12 +67,14 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components, dijkstra
 
 from htetro_opt._validation import check_int
 from htetro_opt.errors import ParameterError
 from htetro_opt.solvers.coverage._layers import LayerGraph
-from htetro_opt.solvers.coverage._rbt import Region, RegionResult, greedy_walk, search_inserting, search_region
+from htetro_opt.solvers.coverage._rbt import (LazyDistances, Region, RegionResult, greedy_walk, search_inserting,
+                                              search_region)
 from htetro_opt.solvers.coverage._result import Coverability
 from htetro_opt.solvers.coverage._spec import STRIPES_ADDITIONS
 
@@ -93,6 +95,12 @@ ORDER_SWEEPS = 12
 """Up to this many sweeps, the greedy order of the sweeps is improved by moves checked on the whole
 DAG (:meth:`_Planner._improve_order`); beyond, each try's DAG solve costs too much and the greedy
 order stands (on a map without splits it is the boustrophedon of stripes)."""
+
+WINDOWS_KEPT = 512
+"""Region windows whose problems (each with its all-pairs distances, ~200 KB for 130 vertices) are kept at
+once, the oldest dropped first: the DAG's Dijkstra prices the sweeps roughly in chain order, so a dropped
+window is seldom asked for again (it is then rebuilt: the same problem). Without the bound a 256 x 256
+map of {O, vI, hI} held 4.7 GB."""
 
 ORDER_TRIES = 300
 """DAG solves the order's improvement may spend."""
@@ -352,10 +360,16 @@ class _Planner:
         self.memo: dict = {} if shared_memo is None else shared_memo  # keyed by content: safe to share
         self._from: dict | None = None  # shortest paths from a port, (dist, pred), kept while the order is improved
         self.problems: dict = {}  # (sweep, chain, block, entry) -> its region problem
-        self.windows: dict = {}  # (sweep, chain, block, window) -> its vertices, their pieces and problems
+        self.windows: dict = {}  # (sweep, chain, block, window) -> its vertices, pieces, graph and problems
+        self._sweep_edges: dict = {}  # sweep -> the workspace graph's edges among its vertices
         self.results: dict = {}
         self.stats = {"regions": 0, "optimal": 0, "memo_hits": 0, "nodes": 0}
         self.time_limited = False
+        # the time limit (see _past_cutoff): region problems built and their seconds, the DAG's blocks not built yet
+        self.began = time.perf_counter()
+        self._build_times: list = []
+        self._per_build, self._built, self._blocks, self._unbuilt = 0.001, set(), set(), 0
+        self.cut = {"greedy_regions": 0, "hidden_edges": 0, "failed_regions": 0}  # what the time limit cut
         self._keys = 0
         lows = np.cumsum((0,) + tuple(widths))
         self.bands: list[tuple[tuple[int, int], tuple[int, int]]] = []  # (own rows, band) per stripe kept
@@ -589,9 +603,11 @@ class _Planner:
         return keep, self.lg.matrix[keep][:, keep]
 
     # --- regions ------------------------------------------------------------------------------
-    def _problem(self, stripe: _Sweep, layout: tuple[int, int], b: int, entry: int, exits: list[int]):
+    def _problem(self, stripe: _Sweep, layout: tuple[int, int], b: int, entry: int, exits: list[int],
+                 light: bool = False):
         """The region problem of block b of a sweep's chain ``layout`` from ``entry``: (nodes, Region,
-        memo key, targets outside the window, local number of each node).
+        memo key, targets outside the window, local number of each node). ``light`` (past a time limit):
+        a problem for the greedy walk only, its shortest paths computed per source on demand, no memo key.
 
         The problem depends on the entry only through its window (its x widens the window where it lies
         outside the block's) and the connected piece of the window it is in, so it is built once per
@@ -610,53 +626,123 @@ class _Planner:
         x1 = int(max(c1 - 1, *xs) + margin)
         window_key = (stripe.key, layout, b, x0, x1)
         window = self.windows.get(window_key)
+        began = time.perf_counter()
         if window is None:
             nodes = stripe.nodes[(self.bx[stripe.nodes] >= x0) & (self.bx[stripe.nodes] <= x1)]
-            _, labels = connected_components(lg.matrix[nodes][:, nodes], directed=False)
-            window = self.windows[window_key] = (nodes, labels, {})
-        nodes, labels, pieces = window
+            sub = self._submatrix(stripe, nodes, x0, x1)
+            _, labels = connected_components(sub, directed=False)
+            window = self.windows[window_key] = (nodes, labels, {}, sub)
+            while len(self.windows) > WINDOWS_KEPT:  # the oldest window's problems: rebuilt if asked again
+                del self.windows[next(iter(self.windows))]
+        nodes, labels, pieces, sub = window
         at = int(np.searchsorted(nodes, entry))
         if at < len(nodes) and nodes[at] == entry:
             piece = int(labels[at])
         else:  # an entry outside the sweep's vertices (cannot happen for a port): its own window
             nodes = np.union1d(nodes, [entry])
-            _, labels = connected_components(lg.matrix[nodes][:, nodes], directed=False)
-            nodes, labels, pieces, piece = nodes, labels, {}, int(labels[int(np.searchsorted(nodes, entry))])
+            sub = lg.matrix[nodes][:, nodes].tocsr()
+            sub.sort_indices()
+            _, labels = connected_components(sub, directed=False)
+            pieces, piece = {}, int(labels[int(np.searchsorted(nodes, entry))])
         found = pieces.get(piece)
         if found is None:
-            found = pieces[piece] = self._build(stripe, layout, b, nodes[labels == piece], x0, x1)
+            mine = labels == piece
+            if not mine.all():
+                sub = sub[mine][:, mine].tocsr()
+                sub.sort_indices()
+            found = pieces[piece] = self._build(stripe, layout, b, nodes[mine], sub, x0, x1, light)
+            self._build_times.append(time.perf_counter() - began)
+            if len(self._build_times) % 16 == 1:  # the median: a build caught by a pause (132 ms against 0.6) is not the rule
+                self._per_build = float(np.median(self._build_times))
+            block = (stripe.key, layout, b)
+            if block not in self._built:
+                self._built.add(block)
+                self._unbuilt -= block in self._blocks
+        if len(self.problems) > WINDOWS_KEPT * 64:  # entry -> problem: a shortcut, dropped wholesale when large
+            self.problems.clear()
         self.problems[key] = found
         return found
 
-    def _build(self, stripe: _Sweep, layout, b: int, nodes: np.ndarray, x0: int, x1: int):
-        """The region problem on a window's connected piece ``nodes`` (see :meth:`_problem`)."""
+    def _submatrix(self, stripe: _Sweep, nodes: np.ndarray, x0: int, x1: int):
+        """The workspace graph on a window's vertices (``nodes``, sorted: the sweep's with B2 in columns
+        x0 … x1), as a CSR matrix with sorted indices: what ``lg.matrix[nodes][:, nodes]`` gives, from
+        the sweep's own edges (kept per sweep) rather than by fancy-indexing the map's whole matrix,
+        which cost more than the region search itself."""
+        edges = self._sweep_edges.get(stripe.key)
+        if edges is None:
+            src, dst, cost = self.lg.edges
+            inside = np.zeros(self.lg.n_nodes, dtype=bool)
+            inside[stripe.nodes] = True
+            keep = inside[src] & inside[dst]
+            edges = self._sweep_edges[stripe.key] = (src[keep], dst[keep], cost[keep].astype(float),
+                                                     self.bx[src[keep]], self.bx[dst[keep]])
+        src, dst, cost, xs, xd = edges
+        keep = (xs >= x0) & (xs <= x1) & (xd >= x0) & (xd <= x1)
+        rows, cols = np.searchsorted(nodes, src[keep]), np.searchsorted(nodes, dst[keep])
+        order = np.lexsort((cols, rows))
+        n = len(nodes)
+        indptr = np.zeros(n + 1, dtype=np.int32)
+        np.cumsum(np.bincount(rows, minlength=n), out=indptr[1:])
+        return csr_matrix((cost[keep][order], cols[order].astype(np.int32), indptr), shape=(n, n))
+
+    def _build(self, stripe: _Sweep, layout, b: int, nodes: np.ndarray, sub, x0: int, x1: int, light: bool = False):
+        """The region problem on a window's connected piece ``nodes``, ``sub`` the graph on them (see
+        :meth:`_problem`)."""
         lg = self.lg
         direction, (r0, r1) = stripe.layouts[layout][2][b]
         c0, c1 = stripe.layouts[layout][0][b]
-        sub = lg.matrix[nodes][:, nodes].tocsr()
-        sub.sort_indices()
         tx, ty = stripe.targets % lg.width, stripe.targets // lg.width
         targets = stripe.targets[(tx >= c0) & (tx < c1) & (ty >= r0) & (ty < r1)]
         fp = lg.footprint[nodes]  # (V, 4)
-        reachable_targets = targets[np.isin(targets, fp)]
-        bit_of = {int(c): t for t, c in enumerate(reachable_targets.tolist())}  # sorted by (y, x)
-        bits = tuple(sum(1 << bit_of[c] for c in set(row) if c in bit_of) for row in fp.tolist())
-        full = (1 << len(bit_of)) - 1
+        reachable_targets = targets[np.isin(targets, fp)]  # sorted by (y, x): bit t is the t-th
+        if len(reachable_targets) <= 62:  # a vertex's bits: OR over its footprint's cells that are targets
+            where = np.searchsorted(reachable_targets, fp)
+            hit = reachable_targets[np.minimum(where, max(len(reachable_targets) - 1, 0))] == fp if len(
+                reachable_targets) else np.zeros(fp.shape, dtype=bool)
+            bits = tuple(np.bitwise_or.reduce(np.where(hit, np.left_shift(1, where, dtype=np.int64), 0),
+                                              axis=1).tolist())
+        else:
+            bit_of = {int(c): t for t, c in enumerate(reachable_targets.tolist())}
+            bits = tuple(sum(1 << bit_of[c] for c in set(row) if c in bit_of) for row in fp.tolist())
+        full = (1 << len(reachable_targets)) - 1
+        local = {int(v): i for i, v in enumerate(nodes.tolist())}
+        if light:  # the greedy walk needs neither the adjacency nor all the pairs' distances
+            paths = LazyDistances(sub)
+            region = Region((), bits, full, paths.dist, paths.pred)
+            return nodes, region, None, len(targets) - len(reachable_targets), local
         width = x1 - x0 + 1
         band_lo = stripe.band[0]
         rel = (nodes // (lg.width * lg.height)) * 10**6 + (self.by[nodes] - band_lo) * width + (self.bx[nodes] - x0)
         memo_key = (width, rel.tobytes(), sub.indptr.tobytes(), sub.indices.tobytes(), sub.data.tobytes(), bits,
                     0 if self.best_first else direction)  # the paper's search orders its moves by the sweep
         dist, pred = dijkstra(sub, return_predecessors=True)
-        adjacency = tuple(
-            tuple(zip(sub.indices[sub.indptr[v]:sub.indptr[v + 1]].tolist(),
-                      sub.data[sub.indptr[v]:sub.indptr[v + 1]].astype(int).tolist()))
-            for v in range(len(nodes)))
+        indptr, indices, costs = sub.indptr.tolist(), sub.indices.tolist(), sub.data.astype(int).tolist()
+        adjacency = tuple(tuple(zip(indices[indptr[v]:indptr[v + 1]], costs[indptr[v]:indptr[v + 1]]))
+                          for v in range(len(nodes)))
         progress = tuple((direction * self.bx[nodes]).tolist())
         target_progress = tuple((direction * (reachable_targets % lg.width)).tolist())
         region = Region(adjacency, bits, full, dist, pred, progress, target_progress)
-        local = {int(v): i for i, v in enumerate(nodes.tolist())}
         return nodes, region, memo_key, len(targets) - len(reachable_targets), local
+
+    def _past_cutoff(self) -> bool:
+        """Whether the time limit has come for the region searches: the deadline less what pricing the
+        DAG's blocks not built yet will take without searching, less a twentieth of the time allowed for
+        what follows the DAG (the mop-up, the commands, the replay). That pricing is a light problem and
+        a greedy walk per block of one chain (:meth:`_kept_late`), measured at about 0.7 of a full
+        problem's build per block not built yet (both cut grids counted), at the seconds a build has
+        taken so far (their median). Past it, every region edge not yet priced takes its greedy walk or is left unpriced
+        (``greedy-fallback``), or fails without being built (the paper's variant), so that the plan ends
+        within the limit: a region problem built past the deadline for each of ~29,000 lazily priced
+        edges made a 2 s limit on tiling_64x64 {O, vI, hI} last 5.3 s."""
+        if self.deadline is None:
+            return False
+        if self.time_limited:
+            return True
+        now = time.perf_counter()
+        reserve = 0.7 * self._per_build * self._unbuilt + 0.05 * (self.deadline - self.began)
+        if now + reserve > self.deadline:
+            self.time_limited = True
+        return self.time_limited
 
     def region_cost(self, sweep: _Sweep, layout: tuple[int, int], b: int, entry: int, exit: int,
                     exits: list[int]) -> float | None:
@@ -665,23 +751,31 @@ class _Planner:
         window from that entry (left to the mop-up); None if impossible."""
         key = (sweep.key, layout, b, entry, exit)
         if key not in self.results:
-            nodes, region, memo_key, dropped, local = self._problem(sweep, layout, b, entry, exits)
+            late = self._past_cutoff()
+            if late and not self.fallback:  # the paper's: a region past the time limit fails, nothing built
+                self.failed[key] = self._failure(sweep, layout, b, entry, exit, RegionResult(0, (), False, 0), True)
+                self.cut["failed_regions"] += 1
+                self.results[key] = None
+                return None
+            nodes, region, memo_key, dropped, local = self._problem(sweep, layout, b, entry, exits, light=late)
             if exit >= 0 and exit not in local:
                 self.results[key] = None
                 return None
             e_local, x_local = local[entry], (local[exit] if exit >= 0 else None)
+            if late and not self._kept_late(sweep, layout, region, e_local, x_local, exits, local):
+                self.cut["hidden_edges"] += 1
+                self.results[key] = None
+                return None
             full_key = (memo_key, e_local, x_local)
             # the fallback is in the key: a failed search is a result, not a walk another planner may take
             full_key = full_key + (self.fallback,)
-            late = False
-            if self.use_memo and full_key in self.memo:
+            if memo_key is not None and self.use_memo and full_key in self.memo:
                 self.stats["memo_hits"] += 1
                 result, late = self.memo[full_key]
             else:
-                if self.deadline is not None and time.perf_counter() > self.deadline:
-                    self.time_limited = late = True
-                    result = greedy_walk(region, e_local, x_local) if self.fallback else \
-                        RegionResult(0, (), False, 0, exhausted=True)
+                if late:  # with greedy-fallback (above): its greedy walk, no search
+                    result = greedy_walk(region, e_local, x_local)
+                    self.cut["greedy_regions"] += 1
                 else:
                     search = search_region if self.best_first else search_inserting
                     result = search(region, e_local, x_local, gain=self.lg.gain, budget=self.budget,
@@ -690,7 +784,8 @@ class _Planner:
                 if result is not None:
                     self.stats["optimal"] += bool(result.optimal)
                     self.stats["nodes"] += result.nodes
-                self.memo[full_key] = (result, late)
+                if memo_key is not None:  # a light problem (past the time limit) has no content key
+                    self.memo[full_key] = (result, late)
             if result is not None and result.exhausted:  # the paper's search not run to its end: the region fails
                 self.failed[key] = self._failure(sweep, layout, b, entry, exit, result, late)
                 result = None
@@ -698,6 +793,22 @@ class _Planner:
                                                              dropped + result.missing.bit_count())
         found = self.results[key]
         return None if found is None else found[0] + DROP_PENALTY * found[2]
+
+    def _kept_late(self, sweep: _Sweep, layout, region: Region, entry: int, exit: int | None, exits: list[int],
+                   local: dict) -> bool:
+        """Past the time limit (``greedy-fallback``): whether a region edge is priced by its greedy walk or
+        left unpriced. Only the sweep's first chain is kept, and from an entry only the exit nearest where
+        the greedy walk's covering ends (ties: the first listed), so that the DAG's remaining part has one
+        chain of greedy regions rather than every (entry, exit) pair of both cut grids (~29,000 edges on
+        tiling_64x64 {O, vI, hI}, each a greedy walk: longer than a 2 s limit)."""
+        if layout != next(iter(sweep.layouts)) or exit is None:
+            return layout == next(iter(sweep.layouts))
+        walk = greedy_walk(region, entry, None)
+        if walk is None:
+            return False
+        row = region.dist[walk.path[-1]]
+        near = min((row[local[q]], i) for i, q in enumerate(exits) if q >= 0 and q in local)
+        return math.isfinite(near[0]) and exits[near[1]] >= 0 and local[exits[near[1]]] == exit
 
     def _failure(self, sweep: _Sweep, layout, b: int, entry: int, exit: int, result, late: bool) -> dict:
         """A failed region search as the result lists it (JSON-ready)."""
@@ -762,6 +873,7 @@ class _Planner:
         (v = −1: a free end); then "G" (the goal vertex, or a free end when None). A sweep's chains
         (its cut grids and, with ``ends="both"``, both directions) run in parallel between its ports."""
         g = _Dag()
+        blocks_seen: set = set()  # this DAG's blocks, for the time limit's estimate (_past_cutoff)
         last = len(chain) - 1
         first = chain[0]
         start_inside = start is not None and start in set(first.nodes.tolist())
@@ -805,10 +917,13 @@ class _Planner:
                 for p in entries:  # each chain its own first node: one-region chains would share an edge
                     g.add_edge(("in", s, p), name(0, p), kind="fixed", cost=0, path=[p])
                 for b in range(len(blocks)):
+                    blocks_seen.add((sweep.key, layout, b))
                     for p in levels[b]:
                         for q in levels[b + 1]:
                             g.add_edge(name(b, p), name(b + 1, q), kind="region", sweep=sweep, layout=layout,
                                        block=b, exits=levels[b + 1])
+        self._blocks = blocks_seen
+        self._unbuilt = len(blocks_seen - self._built)
         return g
 
     def _solve(self, g: _Dag):
@@ -854,8 +969,7 @@ class _Planner:
                 return math.inf
             return plan_total(self.lg, self.cov, self._vertex_path(g, dag_path), found, self.goal, self.mopup)
 
-        if self.deadline is not None and time.perf_counter() > self.deadline:
-            self.time_limited = True
+        if self._past_cutoff():
             return 0  # no time left: the greedy order stands (each try costs a DAG search and its mop-up)
         self._from = {}
         current = [(sweep, sweep.direction) for sweep in self.sweeps]
@@ -867,7 +981,7 @@ class _Planner:
             moves = [(i, i, True) for i in range(n)] + [
                 (i, j, flip) for i in range(1, n) for j in range(1, n) if i != j for flip in (False, True)]
             for i, j, flip in moves:  # the first sweep holds the start: it may turn, never move
-                if tries >= ORDER_TRIES or (self.deadline is not None and time.perf_counter() > self.deadline):
+                if tries >= ORDER_TRIES or self._past_cutoff():
                     break
                 order = list(current)
                 sweep, d = order.pop(i)
@@ -988,21 +1102,36 @@ def plan_stripes(lg: LayerGraph, cov: Coverability, start: int, goal: int | None
     options = dict(region_columns=region_columns, budget=budget, deadline=deadline, memo=memo, additions=additions,
                    shared_memo={}, mopup=mopup or "sequenced")
     first = "split" if split else "joined"
+    began = time.perf_counter()
     planner = _Planner(lg, cov, start, goal, widths, **options, widening=first, ends=ends)
     runs = {(first, ends): planner.plan()}
+    planners = [planner]
+    took = time.perf_counter() - began  # a further candidate: up to twice that (tiling_64x64's joined one, fewer memo hits)
     widenings = [first] + (["joined"] if split and planner.choices else [])
-    cut = False
+    skipped = []
     for widening, e in [(w, e) for e in dict.fromkeys((ends, "sweep")) for w in widenings]:
         if (widening, e) in runs:
             continue
-        if deadline is not None and time.perf_counter() > deadline:
-            cut = True  # a time limit: the candidates planned so far (the first is always planned)
-            break
+        if deadline is not None and (planner.time_limited or time.perf_counter() + 2 * took > deadline):
+            skipped.append(f"{widening}/{e}")  # a time limit: the candidates planned so far (the first always)
+            continue
         # "both" keeps "sweep"'s plan as a candidate: never costlier with its mop-up
-        runs[(widening, e)] = _Planner(lg, cov, start, goal, widths, **options, widening=widening, ends=e).plan()
+        planners.append(_Planner(lg, cov, start, goal, widths, **options, widening=widening, ends=e))
+        runs[(widening, e)] = planners[-1].plan()
+
+    def said(best: StripeOutcome) -> StripeOutcome:  # what the time limit cut, in the result's info
+        if best.time_limited:
+            best.info["time_limit_cut"] = {
+                "greedy_regions": sum(p.cut["greedy_regions"] for p in planners),
+                "unpriced_edges": sum(p.cut["hidden_edges"] for p in planners),
+                "failed_regions": sum(p.cut["failed_regions"] for p in planners),
+                "candidates_skipped": skipped, "order_search_cut": any(p.time_limited for p in planners)
+                and planner.reorder and 2 <= len(planner.sweeps) <= ORDER_SWEEPS}
+        return best
+
     if len(runs) == 1:
-        runs[(first, ends)].time_limited |= cut
-        return runs[(first, ends)]
+        runs[(first, ends)].time_limited |= bool(skipped)
+        return said(runs[(first, ends)])
 
     costs = {key: math.inf if o.dag_cost is None else plan_total(lg, cov, o.path, o.dag_cost, goal, mopup)
              for key, o in runs.items()}
@@ -1018,6 +1147,6 @@ def plan_stripes(lg: LayerGraph, cov: Coverability, start: int, goal: int | None
     best.info["ends"] = key[1]
     for name in ("regions", "regions_optimal", "memo_hits", "nodes"):  # every plan's searches count
         setattr(best, name, sum(getattr(o, name) for o in runs.values()))
-    best.time_limited = cut or any(o.time_limited for o in runs.values())
+    best.time_limited = bool(skipped) or any(o.time_limited for o in runs.values())
     best.failed = {k: v for o in runs.values() for k, v in o.failed.items()}  # every search of the run counts
-    return best
+    return said(best)

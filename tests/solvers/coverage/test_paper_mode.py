@@ -106,6 +106,30 @@ def test_a_time_limit_fails_the_paper_modes_regions_instead_of_a_greedy_walk(spi
     check(ws, plan)
 
 
+
+def test_past_the_time_limit_the_paper_mode_builds_no_region_problem(spies, monkeypatch):
+    # a region past the limit fails as it is: its problem (window, distances) is not built first
+    monkeypatch.setattr(_stripes._Planner, "_build", lambda *a, **k: pytest.fail("a region problem was built"))
+    ws = load_scenario("coverage_16x16").workspace
+    plan = plan_coverage(ws, "O,vI,hI", method="stripes-paper", time_limit=1e-6)
+    assert plan.time_limited and plan.failed_regions and plan.info["time_limit_cut"]["failed_regions"] > 0
+    check(ws, plan)
+
+
+def test_past_the_time_limit_ours_walks_one_chain_greedily_and_says_what_was_cut(monkeypatch):
+    # no search and no full problem: light problems, one greedy walk per region of one chain; the plan
+    # still covers every coverable cell (the mop-up) and re-validates
+    built = []
+    build = _stripes._Planner._build
+    monkeypatch.setattr(_stripes._Planner, "_build", lambda self, *a: built.append(a[-1]) or build(self, *a))
+    monkeypatch.setattr(_stripes, "search_region", lambda *a, **k: pytest.fail("a region was searched"))
+    ws = load_scenario("coverage_16x16").workspace
+    plan = plan_coverage(ws, "O,vI,hI", time_limit=1e-6)
+    cut = plan.info["time_limit_cut"]
+    assert plan.time_limited and plan.success and built and all(built) and plan.regions_optimal == 0
+    assert cut["greedy_regions"] > 0 and cut["unpriced_edges"] > 0 and cut["candidates_skipped"]
+    check(ws, plan)
+
 def test_ours_lists_every_addition_and_the_paper_none():
     assert SPEC.default_of("stripes", "additions") == tuple(STRIPES_ADDITIONS)
     assert SPEC.default_of("stripes-paper", "additions") == ()
