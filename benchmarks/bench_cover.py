@@ -11,6 +11,17 @@ nearest-first.
 
     python benchmarks/bench_cover.py            # the issue's targets
     python benchmarks/bench_cover.py --quick    # the 16 x 16 and 16 x 7 rows only
+    python benchmarks/bench_cover.py --speed    # issue 25's ratios only (below)
+
+``--speed`` (also the last part of a full run; issue 25, item 3): the default method (``stripes``, S = {O,
+vI, hI}) beside the boustrophedon baseline (``--method boustrophedon``: the first layer, O) on maps of
+scattered obstacles (:func:`scattered`: n² / 40 blocks of 1-3 x 1-3 cells at seeded random places) of
+16 x 16 and 64 x 64, several seeds, and coverage_16x16: each plan in its own process, the two methods
+alternated, CPU seconds of the whole process (what ``htetro-opt cover`` costs: imports and tables
+included) and of the planning call alone; the plan-length ratio; whether every coverable cell is
+covered (and the plan re-validates in the simulator); then the wall time, CPU and peak RSS of the
+default method on a 256 x 256 and a 384 x 384 scattered map and on the bundled real map malaga_building
+(177 x 214).
 
 The indoor room's {O} rows start at the roadmap's start (its goal lies behind a doorway the O cannot
 pass) or at the bottom-left pose, both with a free end, and their boustrophedon from the same start.
@@ -19,11 +30,17 @@ pass) or at the bottom-left pose, both with a free end, and their boustrophedon 
 from __future__ import annotations
 
 import argparse
+import json
 import math
+import os
+import subprocess
+import sys
 import time
 
+import numpy as np
+
 from htetro_opt.errors import TilingError
-from htetro_opt.model import SEED004_COMMANDS, Simulator, sweep_tables
+from htetro_opt.model import SEED004_COMMANDS, Simulator, Workspace, sweep_tables
 from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers import plan_coverage
 from htetro_opt.solvers.coverage import LayerGraph
@@ -66,10 +83,92 @@ def run(name: str, layers: str, stripes, method: str = "stripes", where: str = "
             "edges_graph": len(lg.edges[0])}
 
 
+def scattered(n: int, seed: int) -> np.ndarray:
+    """An n x n map of n² / 40 obstacle blocks of 1-3 x 1-3 cells at random places (numpy's default_rng(seed);
+    they may touch or overlap)."""
+    rng = np.random.default_rng(seed)
+    occ = np.zeros((n, n), dtype=bool)
+    for _ in range(n * n // 40):
+        x, y = rng.integers(0, n), rng.integers(0, n)
+        occ[y:y + rng.integers(1, 4), x:x + rng.integers(1, 4)] = True
+    return occ
+
+
+def child(spec: str, method: str) -> None:
+    """One plan in this process (``--child``): prints its figures as JSON."""
+    if spec.startswith("scattered:"):
+        n, seed = (int(v) for v in spec.split(":")[1:])
+        ws = Workspace(scattered(n, seed))
+    else:
+        ws = load_scenario(spec).workspace
+    cpu, wall = time.process_time(), time.perf_counter()
+    plan = plan_coverage(ws, method=method)
+    cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
+    replay = Simulator(ws, commands=SEED004_COMMANDS).run([plan.commands], plan.start)
+    print(json.dumps({"cost": plan.action_cost, "plan_cpu": cpu, "plan_wall": wall, "success": plan.success,
+                      "valid": bool(replay.valid[0] and replay.time[0] == plan.time),
+                      "coverable": int(plan.coverable.sum()), "left": int((plan.coverable & ~plan.covered).sum())}))
+
+
+def in_process(spec: str, method: str) -> dict:
+    """``child`` in a fresh process: its JSON, with the process's CPU seconds, wall seconds and peak RSS (MB)."""
+    wall = time.perf_counter()
+    proc = subprocess.Popen([sys.executable, __file__, "--child", spec, method], stdout=subprocess.PIPE, text=True)
+    out = proc.stdout.read()
+    _, status, usage = os.wait4(proc.pid, 0)
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    assert proc.returncode == 0, f"{spec} {method}: exit {proc.returncode}"
+    row = json.loads(out)
+    row.update(cpu=usage.ru_utime + usage.ru_stime, wall=time.perf_counter() - wall, rss=usage.ru_maxrss / 1024)
+    return row
+
+
+def speed(repeats: int = 2) -> None:
+    """Issue 25's coverage ratios (see the module docstring)."""
+    maps = ["coverage_16x16"] + [f"scattered:16:{s}" for s in range(5)] + [f"scattered:64:{s}" for s in range(3)]
+    print("| map | stripes CPU s: process / planning | boustrophedon CPU s: process / planning | CPU ratio: "
+          "process / planning | plan length: stripes / boustrophedon (ratio) | coverable cells left: stripes / "
+          "boustrophedon | stripes peak RSS MB |")
+    print("|---|---|---|---|---|---|---:|")
+    ratios, planning, lengths = [], [], []
+    for spec in maps:
+        runs = {"stripes": [], "boustrophedon": []}
+        for _ in range(repeats):  # alternated, so that a change in the machine's load hits both
+            for method in runs:
+                runs[method].append(in_process(spec, method))
+        a, b = ({k: float(np.median([r[k] for r in runs[m]])) for k in ("cpu", "plan_cpu", "rss")}
+                for m in ("stripes", "boustrophedon"))
+        pa, pb = runs["stripes"][0], runs["boustrophedon"][0]
+        assert all(r["valid"] for rs in runs.values() for r in rs)
+        ratios.append(a["cpu"] / b["cpu"])
+        planning.append(a["plan_cpu"] / b["plan_cpu"])
+        lengths.append(pa["cost"] / pb["cost"])
+        print(f"| {spec} | {a['cpu']:.2f} / {a['plan_cpu']:.2f} | {b['cpu']:.2f} / {b['plan_cpu']:.2f} "
+              f"| {ratios[-1]:.2f} / {planning[-1]:.1f} | {pa['cost']} / {pb['cost']} ({lengths[-1]:.2f}) "
+              f"| {pa['left']} of {pa['coverable']} / {pb['left']} of {pb['coverable']} | {a['rss']:.0f} |", flush=True)
+    print(f"\nprocess CPU ratio stripes / boustrophedon: max {max(ratios):.2f} (target <= 4); planning alone: "
+          f"{min(planning):.0f}-{max(planning):.0f}x; plan length ratio max {max(lengths):.2f} (target <= 1)\n")
+    print("| map | wall s | CPU s (process) | peak RSS MB | commands | every coverable cell covered |")
+    print("|---|---:|---:|---:|---:|---|")
+    for spec in ("scattered:256:0", "malaga_building", "scattered:384:0"):
+        r = in_process(spec, "stripes")
+        print(f"| {spec} | {r['wall']:.1f} | {r['cpu']:.1f} | {r['rss']:.0f} | {r['cost']} | "
+              f"{'yes' if r['left'] == 0 else 'no: ' + str(r['left']) + ' left'} |", flush=True)
+    load = os.getloadavg()
+    print(f"\nload {load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f} (1 / 5 / 15 min) at the end; "
+          f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="the 16 x 16 and 16 x 7 rows only")
+    parser.add_argument("--speed", action="store_true", help="issue 25's speed ratios only")
+    parser.add_argument("--child", nargs=2, metavar=("MAP", "METHOD"), help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.child:
+        return child(*args.child)
+    if args.speed:
+        return speed()
     began = time.perf_counter()
     sweep_tables()
     print(f"sweep tables: {time.perf_counter() - began:.2f} s (once per process)\n")
@@ -128,7 +227,9 @@ def main() -> None:
               f"| {seq.action_cost} ({seq.mopup_commands}) |")
     print("\nbaseline boustrophedon-O CPU s: "
           + ", ".join(f"{k[0]} ({k[1]}) {v['cpu']:.2f}" for k, v in baselines.items()))
-    print(f"total {time.perf_counter() - began:.1f} s")
+    print(f"total {time.perf_counter() - began:.1f} s\n")
+    if not args.quick:
+        speed()
 
 
 if __name__ == "__main__":

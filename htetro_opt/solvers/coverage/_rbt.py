@@ -88,13 +88,23 @@ def _tables(region: Region, exit: int | None) -> tuple:
     positions = [t for t in range(full.bit_length()) if full >> t & 1]
     targets = [1 << t for t in positions]
     covers = region.tables.get("covers")
-    if covers is None:  # (T, V): vertex v's footprint covers target t
-        covers = region.tables["covers"] = np.array([[b >> t & 1 for b in bits] for t in positions],
-                                                    dtype=bool).reshape(len(positions), n)
+    if covers is None:  # the vertices covering each target, concatenated, and where each target's start
+        lists = [[v for v, b in enumerate(bits) if b >> t & 1] for t in positions]
+        covers = region.tables["covers"] = (np.array([v for c in lists for v in c], dtype=np.int64),
+                                            np.cumsum([0] + [len(c) for c in lists[:-1]], dtype=np.int64),
+                                            all(lists))
+    flat, starts, every = covers
     # via[t][v]: the cheapest way from v to cover target t and then reach the exit (min over its covers c
-    # of dist[v, c] + dexit[c]; inf when no vertex covers t)
-    via = np.where(covers[:, None, :], (dist + dexit[None, :])[None, :, :], np.inf).min(axis=2) if targets \
-        else np.zeros((0, n))
+    # of dist[v, c] + dexit[c]; inf when no vertex covers t): one reduceat over the covers' columns
+    if not targets:
+        via = np.zeros((0, n))
+    elif every:
+        via = np.minimum.reduceat((dist[:, flat] + dexit[flat][None, :]), starts, axis=1).T
+    else:  # some target has no cover (reduceat cannot take an empty group)
+        mask = np.zeros((len(positions), n), dtype=bool)
+        for t, p in enumerate(positions):
+            mask[t] = [b >> p & 1 for b in bits]
+        via = np.where(mask[:, None, :], (dist + dexit[None, :])[None, :, :], np.inf).min(axis=2)
     order = np.ascontiguousarray(np.argsort(-via, axis=0, kind="stable").T)  # (V, T): targets by via, decreasing
     wide = full.bit_length() > 62  # the compiled search's keys would not fit: the Python loop alone runs
     found = region.tables[exit] = (targets, None if wide else np.array(targets, dtype=np.int64),

@@ -658,7 +658,7 @@ class _Planner:
             if block not in self._built:
                 self._built.add(block)
                 self._unbuilt -= block in self._blocks
-        if len(self.problems) > WINDOWS_KEPT * 64:  # entry -> problem: a shortcut, dropped wholesale when large
+        if len(self.problems) > WINDOWS_KEPT * 8:  # entry -> problem: a shortcut, dropped wholesale when large
             self.problems.clear()
         self.problems[key] = found
         return found
@@ -789,7 +789,9 @@ class _Planner:
             if result is not None and result.exhausted:  # the paper's search not run to its end: the region fails
                 self.failed[key] = self._failure(sweep, layout, b, entry, exit, result, late)
                 result = None
-            self.results[key] = None if result is None else (result.cost, [int(nodes[v]) for v in result.path],
+            # the walk in the window's numbers, beside the window's vertices: mapped to the map's only on the
+            # DAG's path (a list of the map's ints per edge held ~800 bytes an edge, 740,000 edges at 256 x 256)
+            self.results[key] = None if result is None else (result.cost, (nodes, result.path),
                                                              dropped + result.missing.bit_count())
         found = self.results[key]
         return None if found is None else found[0] + DROP_PENALTY * found[2]
@@ -1005,7 +1007,8 @@ class _Planner:
             if data["kind"] == "fixed":
                 leg = data["path"] if "path" in data else _walk_back(*data["pred"])
             else:
-                leg = self.results[(data["sweep"].key, data["layout"], data["block"], u[-1], v[-1])][1]
+                nodes, walk = self.results[(data["sweep"].key, data["layout"], data["block"], u[-1], v[-1])][1]
+                leg = nodes[list(walk)].tolist()
             if leg and leg[0] == path[-1]:
                 leg = leg[1:]
             path += leg
