@@ -60,6 +60,7 @@ Our reading of the paper, where it is ambiguous or contradicts itself:
 
 from __future__ import annotations
 
+import hashlib
 import heapq
 import itertools
 import math
@@ -96,8 +97,9 @@ ORDER_SWEEPS = 12
 DAG (:meth:`_Planner._improve_order`); beyond, each try's DAG solve costs too much and the greedy
 order stands (on a map without splits it is the boustrophedon of stripes)."""
 
-WINDOWS_KEPT = 512
-"""Region windows whose problems (each with its all-pairs distances, ~200 KB for 130 vertices) are kept at
+WINDOWS_KEPT = 192
+"""Region windows whose problems (each with its all-pairs distances and per-exit tables, ~450 KB for 130
+vertices) are kept at
 once, the oldest dropped first: the DAG's Dijkstra prices the sweeps roughly in chain order, so a dropped
 window is seldom asked for again (it is then rebuilt: the same problem). Without the bound a 256 x 256
 map of {O, vI, hI} held 4.7 GB."""
@@ -234,7 +236,8 @@ def mop_up(lg: LayerGraph, path: list[int], coverable: np.ndarray, reachable: np
     if order == "nearest" or len(goals) < 3:  # two waypoints have one order from a fixed start
         return added
     nodes = [path[-1]] + goals
-    legs = dijkstra(lg.matrix, indices=nodes)[:, nodes]
+    # the legs between them, 64 sources at a time: all at once held len(nodes) rows of the whole graph
+    legs = np.vstack([dijkstra(lg.matrix, indices=nodes[i:i + 64])[:, nodes] for i in range(0, len(nodes), 64)])
     from htetro_opt.solvers.sequencing import improve
 
     better = improve(np.maximum(legs, legs.T), np.arange(len(nodes)), fixed_start=True)
@@ -713,8 +716,14 @@ class _Planner:
         width = x1 - x0 + 1
         band_lo = stripe.band[0]
         rel = (nodes // (lg.width * lg.height)) * 10**6 + (self.by[nodes] - band_lo) * width + (self.bx[nodes] - x0)
-        memo_key = (width, rel.tobytes(), sub.indptr.tobytes(), sub.indices.tobytes(), sub.data.tobytes(), bits,
-                    0 if self.best_first else direction)  # the paper's search orders its moves by the sweep
+        # the region's content, as a 256-bit digest: the arrays themselves (~8 KB a region) were held for every
+        # region of the run, most of a large map's memory
+        content = hashlib.blake2b(digest_size=32)
+        for part in (np.int64(width).tobytes(), rel.tobytes(), sub.indptr.tobytes(), sub.indices.tobytes(),
+                     sub.data.tobytes(), np.array(bits, dtype=np.int64).tobytes() if full >> 62 == 0 else repr(bits).encode()):
+            content.update(np.int64(len(part)).tobytes())
+            content.update(part)
+        memo_key = (content.digest(), 0 if self.best_first else direction)  # the paper's orders its moves by the sweep
         dist, pred = dijkstra(sub, return_predecessors=True)
         indptr, indices, costs = sub.indptr.tolist(), sub.indices.tolist(), sub.data.astype(int).tolist()
         adjacency = tuple(tuple(zip(indices[indptr[v]:indptr[v + 1]], costs[indptr[v]:indptr[v + 1]]))
@@ -1108,28 +1117,33 @@ def plan_stripes(lg: LayerGraph, cov: Coverability, start: int, goal: int | None
     began = time.perf_counter()
     planner = _Planner(lg, cov, start, goal, widths, **options, widening=first, ends=ends)
     runs = {(first, ends): planner.plan()}
-    planners = [planner]
+    reorder, sweeps, choices = planner.reorder, len(planner.sweeps), planner.choices
+    cuts = [(planner.cut, planner.time_limited)]  # what each candidate's time limit cut (not the planners: their memory)
     took = time.perf_counter() - began  # a further candidate: up to twice that (tiling_64x64's joined one, fewer memo hits)
-    widenings = [first] + (["joined"] if split and planner.choices else [])
+    widenings = [first] + (["joined"] if split and choices else [])
+    time_limited = planner.time_limited
+    del planner  # its windows, problems and DAG: not held while the next candidate is planned
     skipped = []
     for widening, e in [(w, e) for e in dict.fromkeys((ends, "sweep")) for w in widenings]:
         if (widening, e) in runs:
             continue
-        if deadline is not None and (planner.time_limited or time.perf_counter() + 2 * took > deadline):
+        if deadline is not None and (time_limited or time.perf_counter() + 2 * took > deadline):
             skipped.append(f"{widening}/{e}")  # a time limit: the candidates planned so far (the first always)
             continue
         # "both" keeps "sweep"'s plan as a candidate: never costlier with its mop-up
-        planners.append(_Planner(lg, cov, start, goal, widths, **options, widening=widening, ends=e))
-        runs[(widening, e)] = planners[-1].plan()
+        other = _Planner(lg, cov, start, goal, widths, **options, widening=widening, ends=e)
+        runs[(widening, e)] = other.plan()
+        cuts.append((other.cut, other.time_limited))
+        del other
 
     def said(best: StripeOutcome) -> StripeOutcome:  # what the time limit cut, in the result's info
         if best.time_limited:
             best.info["time_limit_cut"] = {
-                "greedy_regions": sum(p.cut["greedy_regions"] for p in planners),
-                "unpriced_edges": sum(p.cut["hidden_edges"] for p in planners),
-                "failed_regions": sum(p.cut["failed_regions"] for p in planners),
-                "candidates_skipped": skipped, "order_search_cut": any(p.time_limited for p in planners)
-                and planner.reorder and 2 <= len(planner.sweeps) <= ORDER_SWEEPS}
+                "greedy_regions": sum(c["greedy_regions"] for c, _ in cuts),
+                "unpriced_edges": sum(c["hidden_edges"] for c, _ in cuts),
+                "failed_regions": sum(c["failed_regions"] for c, _ in cuts),
+                "candidates_skipped": skipped, "order_search_cut": any(late for _, late in cuts)
+                and reorder and 2 <= sweeps <= ORDER_SWEEPS}
         return best
 
     if len(runs) == 1:
