@@ -262,6 +262,19 @@ def mop_up(lg: LayerGraph, path: list[int], coverable: np.ndarray, reachable: np
     return walk if cost(walk) < cost(added) else added
 
 
+class _RegionEdge(tuple):
+    """A region edge's data, (sweep, chain, block, exits) read by name as the fixed edges' dicts are: a tuple
+    of four is ~100 bytes against a dict's ~230, and a 128 x 128 map's DAG has ~210,000 of them."""
+
+    __slots__ = ()
+    _AT = {"sweep": 0, "layout": 1, "block": 2, "exits": 3}
+
+    def __getitem__(self, key):
+        if key == "kind":
+            return "region"
+        return tuple.__getitem__(self, self._AT[key] if isinstance(key, str) else key)
+
+
 class _Dag:
     """The auxiliary DAG: successors in insertion order, each edge's data a dict (networkx's DiGraph
     interface, as far as the planner uses it).
@@ -291,6 +304,18 @@ class _Dag:
             self.edge_count += 1
         else:  # networkx updates an existing edge's data
             old.update(data)
+
+    def add_region(self, u, v, data: _RegionEdge) -> None:
+        """A region edge (never added twice: its tail names its chain and block)."""
+        adj = self.adj
+        succ = adj.get(u)
+        if succ is None:
+            succ = adj[u] = {}
+        if v not in adj:
+            adj[v] = {}
+        if v not in succ:
+            self.edge_count += 1
+        succ[v] = data
 
     def has_node(self, n) -> bool:
         return n in self.adj
@@ -862,8 +887,9 @@ class _Planner:
                     self._from[out] = dijkstra(self.lg.matrix, indices=out, return_predecessors=True)
                 dist, pred = self._from[out]
             for into in intos:
-                if math.isfinite(dist[into]):  # the leg's vertices are walked back only if the path takes it
-                    g.add_edge(tail(out), head(into), kind="fixed", cost=dist[into], pred=(pred, out, into))
+                if math.isfinite(dist[into]):  # the leg walked back now: an edge holding the pred array
+                    # (one of the map's size per port) made most of a large map's memory
+                    g.add_edge(tail(out), head(into), kind="fixed", cost=dist[into], path=_walk_back(pred, out, into))
                     reached.append(into)
         return list(dict.fromkeys(reached))
 
@@ -931,8 +957,7 @@ class _Planner:
                     blocks_seen.add((sweep.key, layout, b))
                     for p in levels[b]:
                         for q in levels[b + 1]:
-                            g.add_edge(name(b, p), name(b + 1, q), kind="region", sweep=sweep, layout=layout,
-                                       block=b, exits=levels[b + 1])
+                            g.add_region(name(b, p), name(b + 1, q), _RegionEdge((sweep, layout, b, levels[b + 1])))
         self._blocks = blocks_seen
         self._unbuilt = len(blocks_seen - self._built)
         return g
