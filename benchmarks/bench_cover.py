@@ -20,8 +20,8 @@ scattered obstacles (:func:`scattered`: n² / 40 blocks of 1-3 x 1-3 cells at se
 alternated, CPU seconds of the whole process (what ``htetro-opt cover`` costs: imports and tables
 included) and of the planning call alone; the plan-length ratio; whether every coverable cell is
 covered (and the plan re-validates in the simulator); then the wall time, CPU and peak RSS of the
-default method on a 256 x 256 and a 384 x 384 scattered map and on the bundled real map malaga_building
-(177 x 214).
+default method on a 256 x 256 scattered map and on the bundled real map malaga_building (177 x 214),
+and with ``--large`` a 384 x 384 scattered map (``--small``: the ratio table only).
 
 The indoor room's {O} rows start at the roadmap's start (its goal lies behind a doorway the O cannot
 pass) or at the bottom-left pose, both with a free end, and their boustrophedon from the same start.
@@ -123,8 +123,9 @@ def in_process(spec: str, method: str) -> dict:
     return row
 
 
-def speed(repeats: int = 2) -> None:
-    """Issue 25's coverage ratios (see the module docstring)."""
+def speed(repeats: int = 2, large=("scattered:256:0", "malaga_building")) -> None:
+    """Issue 25's coverage ratios (see the module docstring); ``large``: the maps of the wall-time and memory
+    table (``--large`` adds the 384 x 384 one)."""
     maps = ["coverage_16x16"] + [f"scattered:16:{s}" for s in range(5)] + [f"scattered:64:{s}" for s in range(3)]
     print("| map | stripes CPU s: process / planning | boustrophedon CPU s: process / planning | CPU ratio: "
           "process / planning | plan length: stripes / boustrophedon (ratio) | coverable cells left: stripes / "
@@ -150,7 +151,7 @@ def speed(repeats: int = 2) -> None:
           f"{min(planning):.0f}-{max(planning):.0f}x; plan length ratio max {max(lengths):.2f} (target <= 1)\n")
     print("| map | wall s | CPU s (process) | peak RSS MB | commands | every coverable cell covered |")
     print("|---|---:|---:|---:|---:|---|")
-    for spec in ("scattered:256:0", "malaga_building", "scattered:384:0"):
+    for spec in large:
         r = in_process(spec, "stripes")
         print(f"| {spec} | {r['wall']:.1f} | {r['cpu']:.1f} | {r['rss']:.0f} | {r['cost']} | "
               f"{'yes' if r['left'] == 0 else 'no: ' + str(r['left']) + ' left'} |", flush=True)
@@ -163,12 +164,15 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="the 16 x 16 and 16 x 7 rows only")
     parser.add_argument("--speed", action="store_true", help="issue 25's speed ratios only")
+    parser.add_argument("--large", action="store_true", help="with --speed: also a 384 x 384 map (minutes)")
+    parser.add_argument("--small", action="store_true", help="with --speed: the ratio table only")
     parser.add_argument("--child", nargs=2, metavar=("MAP", "METHOD"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         return child(*args.child)
     if args.speed:
-        return speed()
+        large = () if args.small else ("scattered:256:0", "malaga_building") + (("scattered:384:0",) if args.large else ())
+        return speed(large=large)
     began = time.perf_counter()
     sweep_tables()
     print(f"sweep tables: {time.perf_counter() - began:.2f} s (once per process)\n")

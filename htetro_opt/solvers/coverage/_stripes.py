@@ -881,7 +881,12 @@ class _Planner:
                 return list(dict.fromkeys(reached))
         for out in outs:
             if self._from is None:
-                dist, pred = dijkstra(self.lg.matrix, indices=out, return_predecessors=True)
+                # bounded first (legs join nearby ports; a search over the whole map per port was quadratic in
+                # its size), the whole map only if some port lies beyond the bound
+                far = max((abs(self.bx[out] - self.bx[v]) + abs(self.by[out] - self.by[v]) for v in intos), default=0)
+                dist, pred = dijkstra(self.lg.matrix, indices=out, return_predecessors=True, limit=2 * far + 16)
+                if not all(math.isfinite(dist[v]) for v in intos):
+                    dist, pred = dijkstra(self.lg.matrix, indices=out, return_predecessors=True)
             else:  # the order's improvement builds many DAGs over the same ports
                 if out not in self._from:
                     self._from[out] = dijkstra(self.lg.matrix, indices=out, return_predecessors=True)
