@@ -149,12 +149,13 @@ def speed(repeats: int = 2, large=("scattered:256:0", "malaga_building")) -> Non
               f"| {pa['left']} of {pa['coverable']} / {pb['left']} of {pb['coverable']} | {a['rss']:.0f} |", flush=True)
     print(f"\nprocess CPU ratio stripes / boustrophedon: max {max(ratios):.2f} (target <= 4); planning alone: "
           f"{min(planning):.0f}-{max(planning):.0f}x; plan length ratio max {max(lengths):.2f} (target <= 1)\n")
-    print("| map | wall s | CPU s (process) | peak RSS MB | commands | every coverable cell covered |")
-    print("|---|---:|---:|---:|---:|---|")
+    print("| map | method | wall s | CPU s (process) | peak RSS MB | commands | every coverable cell covered |")
+    print("|---|---|---:|---:|---:|---:|---|")
     for spec in large:
-        r = in_process(spec, "stripes")
-        print(f"| {spec} | {r['wall']:.1f} | {r['cpu']:.1f} | {r['rss']:.0f} | {r['cost']} | "
-              f"{'yes' if r['left'] == 0 else 'no: ' + str(r['left']) + ' left'} |", flush=True)
+        for method in ("stripes", "boustrophedon"):
+            r = in_process(spec, method)
+            print(f"| {spec} | {method} | {r['wall']:.1f} | {r['cpu']:.1f} | {r['rss']:.0f} | {r['cost']} | "
+                  f"{'yes' if r['left'] == 0 else 'no: ' + str(r['left']) + ' left'} |", flush=True)
     load = os.getloadavg()
     print(f"\nload {load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f} (1 / 5 / 15 min) at the end; "
           f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}")

@@ -680,8 +680,8 @@ class _Planner:
                 sub.sort_indices()
             found = pieces[piece] = self._build(stripe, layout, b, nodes[mine], sub, x0, x1, light)
             self._build_times.append(time.perf_counter() - began)
-            if len(self._build_times) % 16 == 1:  # the median: a build caught by a pause (132 ms against 0.6) is not the rule
-                self._per_build = float(np.median(self._build_times))
+            if len(self._build_times) % 16 == 0:  # the median of 16 or more: a build caught by a pause (132 ms against
+                self._per_build = float(np.median(self._build_times))  # 0.6) is not the rule, nor is the first
             block = (stripe.key, layout, b)
             if block not in self._built:
                 self._built.add(block)
