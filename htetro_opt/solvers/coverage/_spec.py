@@ -23,7 +23,7 @@ STRIPES_ADDITIONS = {
                   "paths that inserts a pose as a cut when no simple path covers the region",
     "greedy-fallback": "a region search that spends its node budget (or runs past the time limit) takes its best "
                        "walk so far, or the greedy walk (past the time limit only one chain of each sweep is priced, "
-                       "each region from its entry to the exit nearest where its greedy walk ends); the paper's "
+                       "each region by its greedy walk, no region searched); the paper's "
                        "search has no budget, so without it the region fails and the result lists it",
     "split-sweeps": "a stripe a wall splits into pieces is also planned piece by piece, the pieces joined by transit "
                     "legs, and the cheaper plan kept; the paper widens it until one piece covers it (Alg. 5 l. 14)",

@@ -396,7 +396,8 @@ class _Planner:
         # the time limit (see _past_cutoff): region problems built and their seconds, the DAG's blocks not built yet
         self.began = time.perf_counter()
         self._build_times: list = []
-        self._per_build, self._built, self._blocks, self._unbuilt = 0.001, set(), set(), 0
+        self._per_build, self._built, self._blocks, self._unbuilt = 0.001, set(), {}, 0
+        self._unpriced = 0  # region edges of the sweeps' first chains in blocks not built yet
         self.cut = {"greedy_regions": 0, "hidden_edges": 0, "failed_regions": 0}  # what the time limit cut
         self._keys = 0
         lows = np.cumsum((0,) + tuple(widths))
@@ -685,7 +686,9 @@ class _Planner:
             block = (stripe.key, layout, b)
             if block not in self._built:
                 self._built.add(block)
-                self._unbuilt -= block in self._blocks
+                if block in self._blocks:
+                    self._unbuilt -= 1
+                    self._unpriced -= self._blocks[block]
         if len(self.problems) > WINDOWS_KEPT * 8:  # entry -> problem: a shortcut, dropped wholesale when large
             self.problems.clear()
         self.problems[key] = found
@@ -762,9 +765,9 @@ class _Planner:
         """Whether the time limit has come for the region searches: the deadline less what pricing the
         DAG's blocks not built yet will take without searching, less a twentieth of the time allowed for
         what follows the DAG (the mop-up, the commands, the replay). That pricing is a light problem and
-        a greedy walk per block of one chain (:meth:`_kept_late`), measured at about 0.7 of a full
-        problem's build per block not built yet (both cut grids counted), at the seconds a build has
-        taken so far (their median). Past it, every region edge not yet priced takes its greedy walk or is left unpriced
+        a greedy walk per entry of each block of one chain, and a leg per edge (:meth:`_kept_late`):
+        measured at about 0.7 of a full problem's build per block not built yet (both cut grids
+        counted) and a fortieth of one per edge of that chain, at the seconds a build has taken so far (their median). Past it, every region edge not yet priced takes its greedy walk or is left unpriced
         (``greedy-fallback``), or fails without being built (the paper's variant), so that the plan ends
         within the limit: a region problem built past the deadline for each of ~29,000 lazily priced
         edges made a 2 s limit on tiling_64x64 {O, vI, hI} last 5.3 s."""
@@ -773,7 +776,7 @@ class _Planner:
         if self.time_limited:
             return True
         now = time.perf_counter()
-        reserve = 0.7 * self._per_build * self._unbuilt + 0.05 * (self.deadline - self.began)
+        reserve = self._per_build * (0.7 * self._unbuilt + self._unpriced / 40) + 0.05 * (self.deadline - self.began)
         if now + reserve > self.deadline:
             self.time_limited = True
         return self.time_limited
@@ -791,15 +794,15 @@ class _Planner:
                 self.cut["failed_regions"] += 1
                 self.results[key] = None
                 return None
+            if late and not self._kept_late(sweep, layout):
+                self.cut["hidden_edges"] += 1
+                self.results[key] = None
+                return None
             nodes, region, memo_key, dropped, local = self._problem(sweep, layout, b, entry, exits, light=late)
             if exit >= 0 and exit not in local:
                 self.results[key] = None
                 return None
             e_local, x_local = local[entry], (local[exit] if exit >= 0 else None)
-            if late and not self._kept_late(sweep, layout, region, e_local, x_local, exits, local):
-                self.cut["hidden_edges"] += 1
-                self.results[key] = None
-                return None
             full_key = (memo_key, e_local, x_local)
             # the fallback is in the key: a failed search is a result, not a walk another planner may take
             full_key = full_key + (self.fallback,)
@@ -830,21 +833,15 @@ class _Planner:
         found = self.results[key]
         return None if found is None else found[0] + DROP_PENALTY * found[2]
 
-    def _kept_late(self, sweep: _Sweep, layout, region: Region, entry: int, exit: int | None, exits: list[int],
-                   local: dict) -> bool:
+    def _kept_late(self, sweep: _Sweep, layout) -> bool:
         """Past the time limit (``greedy-fallback``): whether a region edge is priced by its greedy walk or
-        left unpriced. Only the sweep's first chain is kept, and from an entry only the exit nearest where
-        the greedy walk's covering ends (ties: the first listed), so that the DAG's remaining part has one
-        chain of greedy regions rather than every (entry, exit) pair of both cut grids (~29,000 edges on
-        tiling_64x64 {O, vI, hI}, each a greedy walk: longer than a 2 s limit)."""
-        if layout != next(iter(sweep.layouts)) or exit is None:
-            return layout == next(iter(sweep.layouts))
-        walk = greedy_walk(region, entry, None)
-        if walk is None:
-            return False
-        row = region.dist[walk.path[-1]]
-        near = min((row[local[q]], i) for i, q in enumerate(exits) if q >= 0 and q in local)
-        return math.isfinite(near[0]) and exits[near[1]] >= 0 and local[exits[near[1]]] == exit
+        left unpriced. Only the sweep's first chain is kept (every entry and exit of it: the walk's
+        covering part is walked once per entry and shared by its exits, so an exit costs a leg), so that
+        the DAG's remaining part is one chain of greedy regions rather than both cut grids' (~29,000
+        edges on tiling_64x64 {O, vI, hI}, each built and walked: longer than a 2 s limit). Keeping only
+        the exit nearest each walk's end was cheaper, but could leave a chain with no way through (on
+        malaga_building the whole map then went to the mop-up: 217 s for a 3 s limit)."""
+        return layout == next(iter(sweep.layouts))
 
     def _failure(self, sweep: _Sweep, layout, b: int, entry: int, exit: int, result, late: bool) -> dict:
         """A failed region search as the result lists it (JSON-ready)."""
@@ -915,7 +912,7 @@ class _Planner:
         (v = −1: a free end); then "G" (the goal vertex, or a free end when None). A sweep's chains
         (its cut grids and, with ``ends="both"``, both directions) run in parallel between its ports."""
         g = _Dag()
-        blocks_seen: set = set()  # this DAG's blocks, for the time limit's estimate (_past_cutoff)
+        blocks_seen: dict = {}  # this DAG's blocks -> their edges if the time limit prices them (_past_cutoff)
         last = len(chain) - 1
         first = chain[0]
         start_inside = start is not None and start in set(first.nodes.tolist())
@@ -959,12 +956,14 @@ class _Planner:
                 for p in entries:  # each chain its own first node: one-region chains would share an edge
                     g.add_edge(("in", s, p), name(0, p), kind="fixed", cost=0, path=[p])
                 for b in range(len(blocks)):
-                    blocks_seen.add((sweep.key, layout, b))
+                    blocks_seen[(sweep.key, layout, b)] = len(levels[b]) * len(levels[b + 1]) * (
+                        layout == next(iter(sweep.layouts)))
                     for p in levels[b]:
                         for q in levels[b + 1]:
                             g.add_region(name(b, p), name(b + 1, q), _RegionEdge((sweep, layout, b, levels[b + 1])))
         self._blocks = blocks_seen
-        self._unbuilt = len(blocks_seen - self._built)
+        left = [n for block, n in blocks_seen.items() if block not in self._built]
+        self._unbuilt, self._unpriced = len(left), sum(left)
         return g
 
     def _solve(self, g: _Dag):
