@@ -23,7 +23,11 @@
    free maps of 4096–16 384 waypoints tiled and sequenced, time and peak memory (``memory``).
 
 Run:  python benchmarks/bench_tsp.py [--quick] [--seeds N] [--budget S]
-      [--parts agreement,ga,scale,backends,tsplib,tsplib-ga,obstacles,memory]
+      [--parts agreement,ga,scale,backends,tsplib,tsplib-ga,obstacles,memory,versus]
+      [--tsplib-dir DIR] [--names a,b] [--methods auto,fast-tsp]
+
+7. Versus (issue 25, item 4): auto against fast-tsp at ``--budget`` seconds on TSPLIB instances of 400-2103
+   cities (pcb442, pr1002 and those of VERSUS_OPTIMA found in ``--tsplib-dir``), gap to the optimum.
 """
 
 from __future__ import annotations
@@ -281,6 +285,58 @@ def tsplib(quick: bool, budget: float) -> None:
     print("| mean gap % | | | " + " | ".join(f"{statistics.mean(g):.2f}" for g in gaps.values()) + " |\n")
 
 
+# TSPLIB's published optima (Reinelt) of the instances of 400-2103 cities the ``versus`` part reads from
+# --tsplib-dir (the files are not in the repository: TSPLIB's, fetched by whoever runs the part)
+VERSUS_OPTIMA = {"rd400": 15281, "pcb442": 50778, "d493": 35002, "att532": 27686, "rat575": 6773, "u724": 41910,
+                 "rat783": 8806, "pr1002": 259045, "u1060": 224094, "vm1084": 239297, "pcb1173": 56892,
+                 "d1291": 50801, "rl1304": 252948, "fl1400": 20127, "fl1577": 22249, "d1655": 62128,
+                 "u1817": 57201, "d2103": 80450}
+
+
+def versus(budget: float, tsplib_dir: Path | None, names: list[str] | None, methods: list[str]) -> None:
+    """Issue 25, item 4: ``auto`` against fast-tsp at the same time budget on TSPLIB instances of 400-2103
+    cities, closed tours, run alternately (which one goes first swaps every instance) on the loaded
+    machine: gap to the published optimum, every tour re-priced here. The instances are pcb442 and pr1002
+    (benchmarks/data/tsplib) and those of :data:`VERSUS_OPTIMA` found in ``tsplib_dir``."""
+    found = {}
+    for name in VERSUS_OPTIMA:
+        for folder in (TSPLIB_DIR, tsplib_dir):
+            if folder is not None and (folder / f"{name}.tsp").exists():
+                found[name] = folder / f"{name}.tsp"
+    if names:
+        found = {name: found[name] for name in names}
+    runs = {"auto": ("auto", {"time_limit": budget, "seed": 0}), "fast-tsp": ("fast-tsp", {"time_limit": budget})}
+    runs.update({f"ils-kicks={k}": ("ils", {"kicks": int(k), "seed": 0, "time_limit": 10 * budget})
+                 for k in (m.split("=")[1] for m in methods if m.startswith("ils-kicks="))})
+    labels = [m for m in methods if m in runs]
+    print(f"## auto against fast-tsp, {budget:g} s each, closed tours: gap to the published optimum in % (seconds)\n")
+    print("| instance | n | optimum | " + " | ".join(labels) + " |")
+    print("|---|---:|---:|" + "---:|" * len(labels))
+    gaps = {label: [] for label in labels}
+    for row, (name, path) in enumerate(found.items()):
+        inst = SequencingInstance.from_matrix(load_tsplib(path).cost, closed=True, start=0)
+        optimum = VERSUS_OPTIMA[name]
+        cells = {}
+        for label in (labels if row % 2 == 0 else labels[::-1]):
+            method, options = runs[label]
+            r = sequence_waypoints(inst, method=method, **options)
+            cost = _tour_cost(inst.cost, r.order.tolist(), True)
+            assert sorted(r.order.tolist()) == list(range(inst.n)) and abs(cost - r.cost) <= 1e-6 * cost
+            assert cost >= optimum, (name, method, cost)  # nothing beats a proven optimum
+            gap = 100 * (cost - optimum) / optimum
+            gaps[label].append(gap)
+            extra = f", {r.info['kicks']} kicks" if "kicks" in r.info else ""
+            cells[label] = f"{gap:.2f} ({r.runtime_s:.1f}{extra})"
+        print(f"| {name} | {inst.n} | {optimum} | " + " | ".join(cells[label] for label in labels) + " |", flush=True)
+    print("| mean gap % | | | " + " | ".join(f"{statistics.mean(g):.3f}" for g in gaps.values()) + " |")
+    if len(labels) >= 2:
+        a, b = gaps[labels[0]], gaps[labels[1]]
+        print(f"\n{labels[0]} below {labels[1]} on {sum(x < y - 1e-9 for x, y in zip(a, b))}, equal on "
+              f"{sum(abs(x - y) <= 1e-9 for x, y in zip(a, b))}, above on {sum(x > y + 1e-9 for x, y in zip(a, b))} "
+              f"of {len(a)} instances.")
+    print()
+
+
 def tsplib_ga(budget: float) -> None:
     """Issue 16, item 5: the memetic GA (its local step the compiled local search of ils) and the paper's
     plain GA on the TSPLIB instances of 130+ cities, closed tours, seed 0, under ``budget`` seconds."""
@@ -376,10 +432,15 @@ def main() -> None:
     parser.add_argument("--parts", default="agreement,ga,scale")
     parser.add_argument("--seeds", type=int, default=5)
     parser.add_argument("--budget", type=float, default=10.0, help="backends: the longer time budget in seconds")
+    parser.add_argument("--tsplib-dir", type=Path, default=None,
+                        help="versus: a folder holding more TSPLIB files (name.tsp) of VERSUS_OPTIMA")
+    parser.add_argument("--names", default="", help="versus: only these instances (comma-separated)")
+    parser.add_argument("--methods", default="auto,fast-tsp",
+                        help="versus: the columns, among auto, fast-tsp and ils-kicks=K")
     args = parser.parse_args()
     print(f"# Le et al. 2018 benchmark ({platform.python_version()}, {platform.processor() or platform.machine()})\n")
     parts = args.parts.split(",")
-    known = {"agreement", "ga", "scale", "backends", "memory", "tsplib", "tsplib-ga", "obstacles"}
+    known = {"agreement", "ga", "scale", "backends", "memory", "tsplib", "tsplib-ga", "obstacles", "versus"}
     if set(parts) - known:  # "tiling" moved to bench_tiling.py: say so rather than run nothing
         parser.error(f"unknown parts: {', '.join(sorted(set(parts) - known))} (tiling: benchmarks/bench_tiling.py)")
     if "agreement" in parts:
@@ -398,6 +459,8 @@ def main() -> None:
         tsplib_ga(args.budget)
     if "obstacles" in parts:
         obstacles(30.0)
+    if "versus" in parts:
+        versus(args.budget, args.tsplib_dir, [n for n in args.names.split(",") if n], args.methods.split(","))
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""The ``ils`` method: a compiled, seeded iterated local search (2-opt + Or-opt) on closed tours.
+"""The ``ils`` method: a compiled, seeded iterated local search (3-opt + Or-opt) on closed tours.
 
 Every instance is solved as a **closed, symmetric tour** on ``n`` nodes, or ``n + 1`` with a dummy
 node ``d`` for an open path: legs to ``d`` cost 0, except that a fixed start ``s`` (and a fixed end
@@ -23,9 +23,12 @@ Stützle 2003):
 - **Start**: the nearest-neighbour tour from node 0 (dense), or the waypoints along a Hilbert curve
   through their block centres (implicit: nearest neighbour needs every row of the matrix).
 - **Local search**: a queue of active nodes (the don't-look bits: a node whose moves all failed
-  leaves the queue until an edge at it changes). For an active node ``a``, every 2-opt move that
+  leaves the queue until an edge at it changes). For an active node ``a``, in ``ils`` the LK-style
+  move of :func:`_lk_move` at depth :data:`ILS_DEPTH` (break an edge at ``a``, then each 2-opt and
+  each sequential 3-opt move along the neighbour lists whose partial gains stay positive, the
+  best of them made; Lin and Kernighan 1973), elsewhere (:class:`LocalCore`) every 2-opt move that
   creates an edge from ``a`` (either tour direction) to a neighbour cheaper than the edge it
-  replaces, and every Or-opt move of a segment of 1–3 nodes beginning or ending at ``a`` to an edge
+  replaces; then every Or-opt move of a segment of 1–3 nodes beginning or ending at ``a`` to an edge
   next to one of its ends' neighbours, as it is or reversed; the first improving move is applied.
   Every move is a sequence of 2-opt moves (an Or-opt is two or three), each reversing the shorter
   side of the tour array, and logged, so that a rejected kick is undone exactly. A *full* pass
@@ -65,10 +68,15 @@ from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_in
 from htetro_opt.solvers.sequencing._budgets import default_time_limit
 from htetro_opt.solvers.sequencing._spec import ILS_NEIGHBOURS
 
-__all__ = ["ILS_KICK_SPAN", "LocalCore", "ils_kicks", "solve_ils"]
+__all__ = ["ILS_DEPTH", "ILS_KICK_SPAN", "LocalCore", "ils_kicks", "solve_ils"]
 
 ILS_KICK_SPAN = 100
 """Longest segment of a kick's double bridge (each of its three segments has 1…this many nodes)."""
+
+ILS_DEPTH = 2
+"""Flips of ``ils``'s LK-style move (:func:`_lk_move`): 2, a 2-opt or sequential 3-opt move priced
+without tentative flips. Measured on TSPLIB at 10 s (benchmarks/README.md, issue 25): depth 2 beat
+both 2-opt (depth 0) and depth 5, whose tentative flips cost more time than their moves won."""
 
 _UNLIMITED = 1 << 62
 """A move budget that never runs out."""
@@ -213,13 +221,147 @@ def _d_compiled(cm, a, b):
 
 
 @_jit
+def _lk_move(cm, nbr, nc, tour, pos, log, count, t1, back, depth, eps, touched, added):
+    """An LK-style move from ``t1`` (Lin and Kernighan 1973, as a chain of 2-opt flips): (gain, moves
+    logged, nodes touched, in ``touched[:returned]``); gain 0 and the tour unchanged when no closed tour
+    along the chains gains.
+
+    Break the edge from ``t1`` to its successor (``back`` 0) or predecessor ``t2``; at each level add an
+    edge from the chain's free end ``t2`` to a neighbour ``t3`` whose leg leaves a positive partial gain
+    and break the edge (t4, t3), t4 the neighbour of t3 on t2's side, which closes the tour again (a
+    2-opt flip), then go on from t4, up to ``depth`` flips, never breaking an edge the move added.
+
+    The first two levels are priced on the tour as it is (the positions tell which side of the first
+    flip a node lies on), every first-level candidate and every second-level one: the best closing of
+    these, a 2-opt or a sequential 3-opt move, is made at once. Only when neither gains does the chain
+    go deeper: the two flips are made for real, with the second level's best candidate by
+    ``d(t5, t6) - d(t4, t5)``, and so on; the flips up to the best closed tour are kept, the rest undone.
+    """
+    n = tour.shape[0]
+    k = nbr.shape[1]
+    s = 1 if back == 0 else -1  # the tour direction from t1 to t2
+    t2 = tour[(pos[t1] + s) % n]
+    d12 = _d(cm, t1, t2)
+    base = count
+    for j0 in range(k):
+        g1 = d12 - nc[t2, j0]
+        if g1 <= eps:  # the list is sorted: no later first edge leaves a gain
+            break
+        t3 = nbr[t2, j0]
+        if t3 == t1:
+            continue
+        # (an undone deeper chain leaves the same cycle, but perhaps the array the other way round)
+        s = 1 if tour[(pos[t1] + 1) % n] == t2 else -1
+        t4 = tour[(pos[t3] - s) % n]
+        if t4 == t2:
+            continue
+        g = g1 + _d(cm, t3, t4)
+        best = g - _d(cm, t4, t1)  # the 2-opt move
+        level = 0
+        if best <= eps:  # no gain yet: a 3-opt move must gain more than eps
+            best, level = eps, -1
+        b5 = b6 = -1
+        # level 2 on the tour after the first flip, which reverses S = t2 … t4 (direction s)
+        span = ((pos[t4] - pos[t2]) * s) % n
+        p5 = p6 = -1
+        pv = -np.inf
+        for j in range(k):
+            g2 = g - nc[t4, j]
+            if g2 <= eps:
+                break
+            t5 = nbr[t4, j]
+            if t5 == t1 or t5 == t3:  # t3: t6 would be t2, breaking the edge just added
+                continue
+            if ((pos[t5] - pos[t2]) * s) % n <= span:  # inside S: its order reversed
+                t6 = tour[(pos[t5] + s) % n]
+            else:
+                t6 = tour[(pos[t5] - s) % n]
+            if t6 == t4:
+                continue
+            v = _d(cm, t5, t6) - nc[t4, j]
+            close = g + v - _d(cm, t6, t1)
+            if close > best:
+                best, level, b5, b6 = close, 1, t5, t6
+            if v > pv:
+                pv, p5, p6 = v, t5, t6
+        if level >= 0:
+            _two_opt(tour, pos, t1, t2, t4, t3)  # (t1, t2), (t4, t3) → (t1, t4), (t2, t3)
+            count = _log(log, count, t1, t2, t4, t3)
+            touched[0], touched[1], touched[2], touched[3] = t1, t2, t3, t4
+            if level == 0:
+                return best, count, 4
+            _two_opt(tour, pos, t1, t4, b6, b5)
+            count = _log(log, count, t1, t4, b6, b5)
+            touched[4], touched[5] = b5, b6
+            return best, count, 6
+        if depth <= 2 or p5 < 0 or count + depth >= log.shape[0]:
+            continue
+        # deeper: the two flips for real, then one candidate a level
+        _two_opt(tour, pos, t1, t2, t4, t3)
+        count = _log(log, count, t1, t2, t4, t3)
+        _two_opt(tour, pos, t1, t4, p6, p5)
+        count = _log(log, count, t1, t4, p6, p5)
+        touched[0], touched[1], touched[2], touched[3], touched[4], touched[5] = t1, t2, t3, t4, p5, p6
+        nt = 6
+        added[0, 0], added[0, 1], added[1, 0], added[1, 1] = t2, t3, t4, p5
+        g += pv
+        best = 0.0
+        best_count = base
+        e = p6
+        for lv in range(2, depth):
+            fwd = 1 if tour[(pos[t1] + 1) % n] == e else -1
+            pick = pick4 = -1
+            pick_val = -np.inf
+            for j in range(k):
+                if g - nc[e, j] <= eps:
+                    break
+                c = nbr[e, j]
+                if c == t1:
+                    continue
+                d = tour[(pos[c] - fwd) % n]
+                if d == e:
+                    continue
+                tabu = False
+                for q in range(lv):  # (d, c) must not be an edge this move added
+                    if (added[q, 0] == c and added[q, 1] == d) or (added[q, 0] == d and added[q, 1] == c):
+                        tabu = True
+                        break
+                if tabu:
+                    continue
+                v = _d(cm, c, d) - nc[e, j]
+                if v > pick_val:
+                    pick_val, pick, pick4 = v, c, d
+            if pick < 0:
+                break
+            _two_opt(tour, pos, t1, e, pick4, pick)
+            count = _log(log, count, t1, e, pick4, pick)
+            added[lv, 0], added[lv, 1] = e, pick
+            touched[nt], touched[nt + 1] = pick, pick4
+            nt += 2
+            g += pick_val
+            close = g - _d(cm, pick4, t1)
+            if close > best + eps:
+                best, best_count = close, count
+            e = pick4
+        for m in range(count - 1, best_count - 1, -1):  # back to the best closed tour along the chain
+            a, b, c, d = log[m, 0], log[m, 1], log[m, 2], log[m, 3]
+            _two_opt(tour, pos, a, c, b, d)
+        count = best_count
+        if best > eps:
+            return best, count, nt
+    return 0.0, base, 0
+
+
+@_jit
 def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count, eps, opt2, lengths, full,
-                  budget, halt):
+                  budget, halt, lk):
     """Improve the tour from the queued nodes until the queue is empty or ``budget`` moves are made:
     (gain, head, moves logged, moves made). Stops early when ``halt[0]`` is set (a signal, see
     :func:`htetro_opt._interrupt.kernel_flag`; the caller's result is then thrown away).
 
-    ``opt2``: try 2-opt moves; ``lengths``: the Or-opt segment lengths, ascending (empty: no Or-opt).
+    ``opt2``: try 2-opt moves; ``lengths``: the Or-opt segment lengths, ascending (empty: no Or-opt);
+    ``lk``: with ``opt2`` and not ``full``, the LK-style moves of :func:`_lk_move` of at most ``lk``
+    flips in place of the 2-opt moves (0: 2-opt).
     Restricted (``full`` False, the ILS): a node's candidates are its neighbour list ``nbr`` (legs
     ``nc``, cheapest first), and the scan of a list stops at the first neighbour whose leg leaves no
     gain. ``full``: every other node is a candidate and nothing is pruned, so that a pass from every
@@ -229,6 +371,8 @@ def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count,
     k = n - 1 if full else nbr.shape[1]
     gain_total = 0.0
     moves = 0
+    touched = np.empty(2 * max(lk, 2) + 2, dtype=np.int64)
+    added = np.empty((max(lk, 1), 2), dtype=np.int64)
     while size > 0 and moves < budget:
         if halt[0]:  # one byte read a node: nothing next to the node's scan of its candidates
             break
@@ -237,9 +381,19 @@ def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count,
         size -= 1
         queued[a] = False
         improved = False
+        if lk > 0 and opt2 and not full:
+            for direction in range(2):
+                gain, count, nt = _lk_move(cm, nbr, nc, tour, pos, log, count, a, direction, lk, eps, touched, added)
+                if gain > eps:
+                    gain_total += gain
+                    moves += 1
+                    for t in range(nt):
+                        size = _push(queue, queued, head, size, touched[t])
+                    improved = True
+                    break
         # 2-opt: a new edge (a, c), c a candidate, in both directions of the tour (full: one is
         # enough, every pair of edges being (a, succ a) and (c, succ c) for some a)
-        for direction in range((1 if full else 2) if opt2 else 0):
+        for direction in range((1 if full else 2) if opt2 and not (lk > 0 and not full) else 0):
             if improved:
                 break
             if direction == 0:
@@ -385,14 +539,15 @@ def _descend(cm, nbr, nc, tour, opt2, lengths, full, eps, budget, halt):
         size = _push(queue, queued, 0, size, tour[i])
     log = np.empty((0, 4), dtype=np.int64)  # nothing is undone: no move is logged
     _, _, _, moves = _local_search(cm, nbr, nc, tour, pos, queue, queued, 0, size, log, 0, eps, opt2, lengths,
-                                   full, budget, halt)
+                                   full, budget, halt, 0)
     return moves
 
 
 @_jit
-def _ils(cm, nbr, tour, kicks, span, seed, eps, halt):
+def _ils(cm, nbr, tour, kicks, span, seed, eps, halt, lk):
     """Local search, then ``kicks`` kicks (double bridges); the tour in place. Returns (kicks done,
-    kicks that lowered the cost). Stops early when ``halt[0]`` is set (see :func:`_local_search`)."""
+    kicks that lowered the cost). Stops early when ``halt[0]`` is set (see :func:`_local_search`).
+    ``lk``: the depth of the LK-style moves that replace the 2-opt moves (0: 2-opt, :func:`_lk_move`)."""
     n = tour.shape[0]
     pos = np.empty(n, dtype=np.int64)
     for i in range(n):
@@ -409,7 +564,7 @@ def _ils(cm, nbr, tour, kicks, span, seed, eps, halt):
     for i in range(n):
         size = _push(queue, queued, head, size, tour[i])
     _, head, _, _ = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, 0, eps, True, lengths,
-                                  False, _UNLIMITED, halt)
+                                  False, _UNLIMITED, halt, lk)
     size = 0
     kept = 0
     done = 0
@@ -442,7 +597,7 @@ def _ils(cm, nbr, tour, kicks, span, seed, eps, halt):
         for node in (a1, b1, b2, c1, c2, d1):
             size = _push(queue, queued, head, size, node)
         gain, head, count, _ = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count, eps,
-                                             True, lengths, False, _UNLIMITED, halt)
+                                             True, lengths, False, _UNLIMITED, halt, lk)
         size = 0
         if delta - gain <= eps and count <= log.shape[0]:
             if delta - gain < -eps:
@@ -699,7 +854,8 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     halt = kernel_flag()  # set by SIGINT / SIGTERM under the command line: the kernel returns within moments
     while first or done < kicks:
         step = min(chunk, kicks - done)
-        d, k = _ils(cm, nbr, tour, step, ILS_KICK_SPAN, np.uint64((stream + 0x9E37 * done) % 2**64), eps, halt)
+        d, k = _ils(cm, nbr, tour, step, ILS_KICK_SPAN, np.uint64((stream + 0x9E37 * done) % 2**64), eps, halt,
+                    ILS_DEPTH)
         first = False
         done += d
         kept += k
@@ -772,7 +928,7 @@ class LocalCore:
             return order
         tour = order if self.dummy is None else np.append(order, self.dummy)
         tour = np.ascontiguousarray(tour, dtype=np.int64)
-        _ils(self.cm, self.nbr, tour, int(kicks), ILS_KICK_SPAN, np.uint64(seed % 2**64), self.eps, kernel_flag())
+        _ils(self.cm, self.nbr, tour, int(kicks), ILS_KICK_SPAN, np.uint64(seed % 2**64), self.eps, kernel_flag(), 0)
         return _decode(tour, self.dummy, self.instance)
 
     def descend(self, order, *, two_opt: bool = True, lengths=(1, 2, 3), certify: bool = True,

@@ -63,12 +63,13 @@ def test_never_below_the_held_karp_optimum_over_seeds():
 def test_same_seed_same_order_and_the_budget_is_kicks():
     C = euclidean(300, 3)
     inst = SequencingInstance.from_matrix(C, closed=True)
-    a = sequence_waypoints(inst, method="ils", seed=5, kicks=20_000)
-    b = sequence_waypoints(inst, method="ils", seed=5, kicks=20_000)
-    c = sequence_waypoints(inst, method="ils", seed=6, kicks=20_000)
-    assert np.array_equal(a.order, b.order) and a.info["kicks"] == 20_000 and not a.info["timed_out"]
+    # 2000 kicks: the 3-opt search brings seeds 5 and 6 to the same tour by 5000 on this instance
+    a = sequence_waypoints(inst, method="ils", seed=5, kicks=2_000)
+    b = sequence_waypoints(inst, method="ils", seed=5, kicks=2_000)
+    c = sequence_waypoints(inst, method="ils", seed=6, kicks=2_000)
+    assert np.array_equal(a.order, b.order) and a.info["kicks"] == 2_000 and not a.info["timed_out"]
     assert not np.array_equal(a.order, c.order)  # another seed, another walk (and here another tour)
-    assert ils_kicks(300) > 20_000
+    assert ils_kicks(300) > 2_000
 
 
 def test_better_than_plain_local_search():
@@ -177,3 +178,39 @@ def test_a_free_256_map_tiles_and_sequences_in_linear_memory():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     assert out[:3] == ["True", "True", "True"]
     assert int(out[3]) < 1500  # MB; 317 MB measured (benchmarks/README.md)
+
+
+def test_the_lk_move_gains_what_a_repricing_loop_says_and_keeps_a_tour():
+    """The LK-style move (2-opt and sequential 3-opt priced without flips, deeper chains flipped and
+    undone): on random tours of a Euclidean instance, the gain it reports is the fall of the tour's cost
+    re-priced by a plain loop, the tour stays a permutation with consistent positions, and it makes
+    3-opt moves (two flips) and deeper ones, not only 2-opt."""
+    from htetro_opt.solvers.sequencing import _ils
+
+    n = 80
+    C = euclidean(n, 21)
+    nbr = _ils._neighbour_lists(C, 8)
+    nc = _ils._neighbour_costs(C, nbr)
+    rng = np.random.default_rng(0)
+
+    def loop_cost(tour):
+        return sum(C[tour[i], tour[(i + 1) % n]] for i in range(n))
+
+    flips = set()
+    for _ in range(20):
+        tour = rng.permutation(n).astype(np.int64)
+        pos = np.empty(n, dtype=np.int64)
+        pos[tour] = np.arange(n)
+        log = np.empty((4 * n + 64, 4), dtype=np.int64)
+        touched = np.empty(14, dtype=np.int64)
+        added = np.empty((6, 2), dtype=np.int64)
+        for t1 in range(n):
+            for back in (0, 1):
+                before = loop_cost(tour)
+                gain, count, _ = _ils._lk_move(C, nbr, nc, tour, pos, log, 0, t1, back, 6, 1e-9, touched, added)
+                assert sorted(tour.tolist()) == list(range(n)) and np.array_equal(pos[tour], np.arange(n))
+                assert before - loop_cost(tour) == pytest.approx(gain, abs=1e-9)
+                if gain > 0:
+                    flips.add(int(count))
+    assert {1, 2} <= flips and max(flips) >= 3
+
