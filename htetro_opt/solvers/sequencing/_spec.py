@@ -171,7 +171,7 @@ METHODS = (
     Method("local", "._local:solve_local", "nearest neighbour + 2-opt/Or-opt, iterated with --restarts",
            ("seed", "time_limit", "progress", "restarts", "max_starts"),
            seeded=lambda options: options.get("restarts", 0) > 0, capabilities={"progress"}),
-    Method("ils", "._ils:solve_ils", "the compiled, seeded iterated local search (2-opt and 3-opt, Or-opt, double-bridge "
+    Method("ils", "._ils:solve_ils", "the compiled, seeded iterated local search (2-opt, Or-opt, double-bridge "
            "kicks)", ("seed", "time_limit", "kicks", "neighbours"), seeded=True, capabilities={"tours", "implicit"}),
     Method("ga", "._ga:solve_ga", "the paper's GA on DEAP with our additions (order crossover, distinct "
            "survivors, a 2-opt/Or-opt step)", _GA, defaults={"additions": tuple(GA_ADDITIONS), "patience": 50},
