@@ -77,7 +77,7 @@ ILS_DEPTH = 0
 TSPLIB instances of 400-2103 cities at 10 s (benchmarks/README.md, issue 25): depth 2 (2-opt and
 sequential 3-opt, priced without tentative flips) wins more per kick (pr1002, 100 kicks a node: 0.15 %
 above the optimum against 0.51 %) but costs twice the time per kick, and at 10 s its mean gap equals
-the 2-opt search's (0.385 % both, 8 instances better, 8 worse); depth 5 is slower still. So the
+the 2-opt search's (0.385 % both, 8 instances better, 9 worse, 1 equal); depth 5 is slower still. So the
 default stays 2-opt (and the runtimes at 10⁶ kicks of large maps stay where they were)."""
 
 _UNLIMITED = 1 << 62
