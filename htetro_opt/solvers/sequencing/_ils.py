@@ -25,7 +25,7 @@ Stützle 2003):
 - **Local search**: a queue of active nodes (the don't-look bits: a node whose moves all failed
   leaves the queue until an edge at it changes). For an active node ``a``, every 2-opt move that
   creates an edge from ``a`` (either tour direction) to a neighbour cheaper than the edge it
-  replaces (with :data:`ILS_DEPTH` above 0, in ``ils`` only: the LK-style move of :func:`_lk_move`
+  replaces (with ``lk_depth`` above 0, in ``ils`` only: the LK-style move of :func:`_lk_move`
   instead, 2-opt and sequential 3-opt moves along the neighbour lists, Lin and Kernighan 1973), and
   every Or-opt move of a segment of 1–3 nodes beginning or ending at ``a`` to an edge
   next to one of its ends' neighbours, as it is or reversed; the first improving move is applied.
@@ -65,20 +65,12 @@ from htetro_opt._validation import as_rng, check_int, check_time_limit
 from htetro_opt.errors import ParameterError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance, eq2_legs
 from htetro_opt.solvers.sequencing._budgets import default_time_limit
-from htetro_opt.solvers.sequencing._spec import ILS_NEIGHBOURS
+from htetro_opt.solvers.sequencing._spec import ILS_LK_DEPTH, ILS_NEIGHBOURS
 
-__all__ = ["ILS_DEPTH", "ILS_KICK_SPAN", "LocalCore", "ils_kicks", "solve_ils"]
+__all__ = ["ILS_KICK_SPAN", "LocalCore", "ils_kicks", "solve_ils"]
 
 ILS_KICK_SPAN = 100
 """Longest segment of a kick's double bridge (each of its three segments has 1…this many nodes)."""
-
-ILS_DEPTH = 0
-"""Flips of ``ils``'s LK-style move (:func:`_lk_move`), 0: none, the plain 2-opt moves. Measured on 18
-TSPLIB instances of 400-2103 cities at 10 s (benchmarks/README.md, issue 25): depth 2 (2-opt and
-sequential 3-opt, priced without tentative flips) wins more per kick (pr1002, 100 kicks a node: 0.15 %
-above the optimum against 0.51 %) but costs twice the time per kick, and at 10 s its mean gap equals
-the 2-opt search's (0.385 % both, 8 instances better, 9 worse, 1 equal); depth 5 is slower still. So the
-default stays 2-opt (and the runtimes at 10⁶ kicks of large maps stay where they were)."""
 
 _UNLIMITED = 1 << 62
 """A move budget that never runs out."""
@@ -771,7 +763,7 @@ def _costs_kind(instance) -> str:
 
 
 def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int | None = None,
-              neighbours: int = ILS_NEIGHBOURS) -> tuple[np.ndarray, dict]:
+              neighbours: int = ILS_NEIGHBOURS, lk_depth: int = ILS_LK_DEPTH) -> tuple[np.ndarray, dict]:
     """Iterated local search (2-opt + Or-opt, local double-bridge kicks), compiled and seeded.
 
     Parameters
@@ -790,6 +782,9 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
         search only).
     neighbours : int
         Size of the neighbour lists.
+    lk_depth : int
+        Flips of the LK-style move that replaces the 2-opt moves (0, the default: plain 2-opt; 2: 2-opt
+        and sequential 3-opt moves, stronger a kick and about twice as slow, see ``ILS_LK_DEPTH``).
 
     Returns
     -------
@@ -857,7 +852,7 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     while first or done < kicks:
         step = min(chunk, kicks - done)
         d, k = _ils(cm, nbr, tour, step, ILS_KICK_SPAN, np.uint64((stream + 0x9E37 * done) % 2**64), eps, halt,
-                    ILS_DEPTH)
+                    lk_depth)
         first = False
         done += d
         kept += k
