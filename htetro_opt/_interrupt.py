@@ -138,7 +138,22 @@ def _raise(signum, frame) -> None:
     if _flag is not None:
         _flag[0] = 1
     if not again:
+        if _in_native_callback(frame):
+            # An exception raised here would be swallowed by ctypes ("Exception ignored on calling ctypes
+            # callback function", a traceback on stderr) and the signal lost until GRACE ends the process:
+            # end it now, as at a second signal.
+            _end()
         raise KeyboardInterrupt if signum == signal.SIGINT else Terminated()
+
+
+def _in_native_callback(frame) -> bool:
+    """Whether ``frame`` runs inside llvmlite, whose Python callbacks (numba's object cache, called by LLVM
+    through ctypes while a kernel is compiled or loaded) cannot pass an exception on to their caller."""
+    while frame is not None:
+        if frame.f_globals.get("__name__", "").startswith("llvmlite"):
+            return True
+        frame = frame.f_back
+    return False
 
 
 def _notify(signum: int) -> None:

@@ -255,6 +255,24 @@ def test_a_main_thread_stuck_in_c_is_ended_by_the_helper_thread(tmp_path):
     assert not partial.exists()
 
 
+@pytest.mark.parametrize("signum, code, word", [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")])
+def test_a_signal_inside_an_llvm_callback_still_ends_with_the_one_line(signum, code, word):
+    """A signal whose handler runs inside llvmlite's ctypes callback (numba's object cache, while a kernel
+    is compiled or loaded): ctypes would swallow the exception with a traceback and the code would go on;
+    the process ends there with the line and the status. The callback's module is named like llvmlite's."""
+    script = (
+        "import ctypes, os, signal, sys\n"
+        "from htetro_opt._interrupt import install\n"
+        "install()\n"
+        "scope = {'__name__': 'llvmlite.binding.executionengine', 'os': os}\n"
+        "exec('def notify():\\n    os.kill(os.getpid(), %d)\\n    for _ in range(1000): pass\\n', scope)\n"
+        "ctypes.CFUNCTYPE(None)(scope['notify'])()\n"
+        "print('went on after the signal', flush=True)\n" % int(signum))
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert done.returncode == code and done.stderr.splitlines() == [word], done.stderr
+    assert done.stdout == ""
+
+
 # --- a study's workers ------------------------------------------------------------------------------------
 STUDY = """name = "{name}"
 task = "plan"
