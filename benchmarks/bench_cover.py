@@ -44,6 +44,7 @@ from htetro_opt.model import SEED004_COMMANDS, Simulator, Workspace, sweep_table
 from htetro_opt.scenarios import load_scenario
 from htetro_opt.solvers import plan_coverage
 from htetro_opt.solvers.coverage import LayerGraph
+from htetro_opt.solvers.coverage._spec import SPEC as COVERAGE_SPEC
 
 CASES = [
     ("coverage_16x16", "O", 4),
@@ -72,7 +73,9 @@ def run(name: str, layers: str, stripes, method: str = "stripes", where: str = "
         start = sc.start
         goal = sc.goal if where == "roadmap" else None
     cpu, wall = time.process_time(), time.perf_counter()
-    plan = plan_coverage(sc.workspace, layers, method=method, stripes=stripes, start=start, goal=goal, **options)
+    if COVERAGE_SPEC.method(method).takes("stripes"):  # the baselines take no stripe layout
+        options["stripes"] = stripes
+    plan = plan_coverage(sc.workspace, layers, method=method, start=start, goal=goal, **options)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
     sim = Simulator(sc.workspace, commands=SEED004_COMMANDS)
     replay = sim.run([plan.commands], plan.start)
