@@ -291,13 +291,18 @@ class _Dag:
         self.adj: dict = {}
         self.edge_count = 0
 
-    def add_edge(self, u, v, **data) -> None:
+    def _successors(self, u, v) -> dict:
+        """``u``'s successors, both nodes added first if new (in insertion order, as networkx)."""
         adj = self.adj
         succ = adj.get(u)
         if succ is None:
             succ = adj[u] = {}
         if v not in adj:
             adj[v] = {}
+        return succ
+
+    def add_edge(self, u, v, **data) -> None:
+        succ = self._successors(u, v)
         old = succ.get(v)
         if old is None:
             succ[v] = data
@@ -307,12 +312,7 @@ class _Dag:
 
     def add_region(self, u, v, data: _RegionEdge) -> None:
         """A region edge (never added twice: its tail names its chain and block)."""
-        adj = self.adj
-        succ = adj.get(u)
-        if succ is None:
-            succ = adj[u] = {}
-        if v not in adj:
-            adj[v] = {}
+        succ = self._successors(u, v)
         if v not in succ:
             self.edge_count += 1
         succ[v] = data
