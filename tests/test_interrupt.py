@@ -172,10 +172,13 @@ def test_the_flag_is_clear_outside_the_command_line():
 def test_a_set_flag_stops_the_ils_kernel_and_a_clear_one_changes_nothing():
     ils, cm, nbr, eps, m = _ils_case()
     start = np.arange(m, dtype=np.int64)
-    halted, free = start.copy(), start.copy()
-    assert ils._ils(cm, nbr, halted, 500, ils.ILS_KICK_SPAN, np.uint64(7), eps, np.ones(1, np.uint8)) == (0, 0)
-    assert halted.tolist() == start.tolist()  # not one move: the flag is read before the first
-    done, _ = ils._ils(cm, nbr, free, 500, ils.ILS_KICK_SPAN, np.uint64(7), eps, np.zeros(1, np.uint8))
+    free = start.copy()
+    for depth in (0, 2):  # the 2-opt moves and the LK-style move (lk_depth) alike
+        halted = start.copy()
+        halt = np.ones(1, np.uint8)
+        assert ils._ils(cm, nbr, halted, 500, ils.ILS_KICK_SPAN, np.uint64(7), eps, halt, depth) == (0, 0)
+        assert halted.tolist() == start.tolist()  # not one move: the flag is read before the first
+    done, _ = ils._ils(cm, nbr, free, 500, ils.ILS_KICK_SPAN, np.uint64(7), eps, np.zeros(1, np.uint8), 0)
     assert done == 500 and ils._tour_cost(cm, free) < ils._tour_cost(cm, start)
     stuck = start.copy()
     assert ils._descend(cm, nbr, ils._neighbour_costs(cm, nbr), stuck, True, np.arange(1, 4), True, eps,
