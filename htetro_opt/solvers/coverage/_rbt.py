@@ -245,7 +245,6 @@ def _astar(indptr, indices, costs, bits, full, entry, exit, gain, budget, dexit,
     parent = {k0: -1}
     heap = [(bound(entry, full & ~m0), 0, entry, m0)]
     expanded = 0
-    mask_of = (1 << shift) - 1
     while len(heap):
         f, neg_g, v, mask = heapq.heappop(heap)
         g = -neg_g

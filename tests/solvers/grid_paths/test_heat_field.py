@@ -188,7 +188,6 @@ def pinch_nodes(occ) -> set[tuple[int, int]]:
 def skfem_reference(occ, source, sink, k_obstacle, scale, split=False):
     """Q1 with scikit-fem's own assembly on the conducting cells, k scaled by ``scale``; with ``split``
     every pinch node is one mesh node per element around it."""
-    w = occ.shape[1]
     cells = np.argwhere(np.ones_like(occ) if k_obstacle > 0 else ~occ)  # (y, x)
     corner = [(0, 0), (1, 0), (1, 1), (0, 1)]  # counter-clockwise (i, j)
     pinches = pinch_nodes(occ) if split else set()
