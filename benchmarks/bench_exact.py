@@ -1,7 +1,8 @@
 """The graph-free exact planner at real-map scale, side by side with scipy's point-robot Dijkstra.
 
-``python benchmarks/bench_exact.py [--sizes 1.7M,4M] [--old-vs-new]`` builds building-like maps (see
-:func:`building_map`), plans one long leg on each with the new planner (``dijkstra`` and ``astar``, each in
+``python benchmarks/bench_exact.py [--sizes 1.7M,4M] [--map FILE.yaml ...] [--upsample K] [--old-vs-new]``
+builds building-like maps (see :func:`building_map`) and loads real ROS ``map_server`` maps given with
+``--map`` (read by the project's loader; ``--upsample K`` also plans each at K x K finer cells), plans one long leg on each with the new planner (``dijkstra`` and ``astar``, each in
 its own process so that ``resource.getrusage``'s peak resident memory is that run's), times
 scipy.sparse.csgraph.dijkstra for a point robot over the same free cells (4-connected, unit steps) in
 another process, and prints a Markdown table with the ratios and the machine's load (``uptime``).
@@ -85,12 +86,18 @@ SIZES = {"1.7M": (1006, 1674), "4M": (1600, 2500), "300x600": (300, 600)}
 
 
 def _endpoints(occ: np.ndarray):
-    """Start near the lower-left corner, goal near the upper-right one, both in free open space."""
-    from scipy.ndimage import distance_transform_cdt
+    """Start near the lower-left corner, goal near the upper-right one, both in free open space.
+
+    Both lie in the largest 4-connected piece of the open space (at least 6 cells from any obstacle),
+    so that on a real map, whose free cells fall into separate rooms and scanned fragments, the leg
+    has a way through.
+    """
+    from scipy.ndimage import distance_transform_cdt, label
 
     clear = distance_transform_cdt(~occ, metric="chessboard")
-    h, w = occ.shape
-    ys, xs = np.nonzero(clear >= 6)
+    pieces, count = label(clear >= 6)
+    largest = np.argmax(np.bincount(pieces.ravel())[1:]) + 1 if count else 0
+    ys, xs = np.nonzero(pieces == largest)
     start = np.argmin(xs + ys)
     goal = np.argmax(xs + ys)
     return (int(xs[start]), int(ys[start])), (int(xs[goal]), int(ys[goal]))
@@ -100,10 +107,30 @@ def _peak_bytes() -> int:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # kB on Linux
 
 
+def _map(size: str) -> np.ndarray:
+    """A generated map by its size name, or ``PATH.yaml[@K]``: a ROS map, its cells split K x K."""
+    if size in SIZES:
+        return building_map(*SIZES[size])
+    from htetro_opt.scenarios.rosmap import load_ros_map
+
+    path, _, k = size.partition("@")
+    occ, _ = load_ros_map(path)
+    k = int(k or 1)
+    return np.repeat(np.repeat(occ, k, axis=0), k, axis=1)
+
+
+def _name(size: str, occ_shape) -> str:
+    if size in SIZES:
+        return f"{size} ({SIZES[size][0]} x {SIZES[size][1]})"
+    path, _, k = size.partition("@")
+    stem = path.rsplit("/", 1)[-1].removesuffix(".yaml")
+    return f"{stem}{f' split {k} x {k}' if k else ''} ({occ_shape[1]} x {occ_shape[0]})"
+
+
 def run_one(kind: str, size: str) -> dict:
     """One measurement in this process: ``new-dijkstra``, ``new-astar``, ``old-dijkstra`` or ``scipy``."""
-    width, height = SIZES[size]
-    occ = building_map(width, height)
+    occ = _map(size)
+    height, width = occ.shape
     (sx, sy), (gx, gy) = _endpoints(occ)
     base = _peak_bytes()
     if kind == "scipy":
@@ -121,16 +148,18 @@ def run_one(kind: str, size: str) -> dict:
         built = time.perf_counter()
         dist = dijkstra(graph, directed=False, indices=int(index[sy, sx]))
         done = time.perf_counter()
-        return {"kind": kind, "size": size, "cells": width * height, "free": int(free.sum()),
+        return {"kind": kind, "size": size, "name": _name(size, occ.shape), "cells": width * height,
+                "free": int(free.sum()),
                 "graph_s": built - began, "search_s": done - built, "distance": float(dist[gy * width + gx]),
                 "peak": _peak_bytes(), "base": base}
     from htetro_opt.model import Pose, Workspace
     from htetro_opt.solvers.grid_paths import plan_exact
     from htetro_opt.solvers.grid_paths._exact import _plan_graph
 
-    warm = Workspace(np.zeros((12, 12), dtype=bool))  # compile or load the kernels before the clock starts
-    plan_exact(warm, [Pose(2, 2, "O", 0), Pose(8, 8, "O", 0)], method="dijkstra")
-    plan_exact(warm, [Pose(2, 2, "O", 0), Pose(8, 8, "O", 0)], method="astar")
+    # compile or load the kernels before the clock starts: 40 x 40 is past the interpreter's 2**15 poses
+    warm = Workspace(np.zeros((40, 40), dtype=bool))
+    plan_exact(warm, [Pose(2, 2, "O", 0), Pose(30, 30, "O", 0)], method="dijkstra")
+    plan_exact(warm, [Pose(2, 2, "O", 0), Pose(30, 30, "O", 0)], method="astar")
     ws = Workspace(occ)
     roadmap = [Pose(sx, sy, "O", 0), Pose(gx, gy, "O", 0)]
     method = kind.split("-", 1)[1]
@@ -155,6 +184,8 @@ def _child(kind: str, size: str) -> dict:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", default="1.7M,4M")
+    parser.add_argument("--map", action="append", default=[], help="a ROS map_server YAML (repeatable)")
+    parser.add_argument("--upsample", type=int, default=1, help="also plan each --map at K x K finer cells")
     parser.add_argument("--old-vs-new", action="store_true")
     parser.add_argument("--one")
     parser.add_argument("--size")
@@ -168,12 +199,16 @@ def main() -> None:
     print("| map | cells (free) | scipy point robot: graph + Dijkstra | method | plan time | expanded | wall | "
           "peak RSS | target (2 s + 25x scipy) | ratio to scipy |")
     print("|---|---|---:|---|---:|---:|---:|---:|---:|---:|")
-    for size in [s for s in args.sizes.split(",") if s]:
+    sizes = [s for s in args.sizes.split(",") if s]
+    for path in args.map:
+        sizes += [path] + ([f"{path}@{args.upsample}"] if args.upsample > 1 else [])
+    for size in sizes:
         scipy = _child("scipy", size)
         for kind in ("new-astar", "new-dijkstra"):
             r = _child(kind, size)
+            assert r["reached"], r  # the endpoints share one piece of open space: a plan exists
             target = 2 + 25 * scipy["search_s"]
-            print(f"| {size} ({SIZES[size][0]} x {SIZES[size][1]}) | {r['cells']:,} ({r['free']:,}) | "
+            print(f"| {scipy['name']} | {r['cells']:,} ({r['free']:,}) | "
                   f"{scipy['graph_s']:.2f} + {scipy['search_s']:.2f} s | {kind[4:]} | {r['time']:g} s | "
                   f"{r['expanded']:,} | {r['seconds']:.1f} s | {r['peak'] / gib:.2f} GiB | {target:.1f} s | "
                   f"{r['seconds'] / scipy['search_s']:.0f}x |", flush=True)
