@@ -24,8 +24,12 @@ Synthetic N x N maps: axis-aligned rectangles with sides drawn in [2, N/33) plac
 seeds) until at least 20 % of the cells are blocked; O-shaped start (10, 10) and goal (N - 10, N - 10)
 on cleared 9 x 9 squares.
 
+Part 5 also runs on real ROS ``map_server`` maps given with ``--map`` (read by the project's loader;
+one leg between the open cells nearest two opposite corners of the largest piece of open space, as
+bench_exact.py picks them).
+
 Run:  python benchmarks/bench_heat.py [--sizes 24,128,512,1000] [--clutter 100] [--skip-plans]
-                                      [--pairs 3] [--only-e2e]
+                                      [--pairs 3] [--only-e2e] [--map FILE.yaml ...]
 """
 
 from __future__ import annotations
@@ -83,12 +87,24 @@ def clutter(seed: int, n: int = 32):
             return ws, roadmap, exact
 
 
+def real_map(yaml_path: str):
+    """A ROS map and one long O-shape leg across its largest piece of open space."""
+    from bench_exact import _endpoints  # the same endpoints as the exact planner's benchmark
+
+    from htetro_opt.model import Pose, Workspace
+    from htetro_opt.scenarios.rosmap import load_ros_map
+
+    occ, _ = load_ros_map(yaml_path)
+    (sx, sy), (gx, gy) = _endpoints(occ)
+    return Workspace(occ), [Pose(sx, sy, "O", 0), Pose(gx, gy, "O", 0)]
+
+
 def _child(job, queue):
     """One measured case in a fresh process (peak RSS is per process)."""
     from htetro_opt.solvers.grid_paths import plan_exact, plan_heat
 
     kind, n, options = job
-    ws, roadmap = synthetic(n)
+    ws, roadmap = synthetic(n) if isinstance(n, int) else real_map(n)
     field_cpu = []
     if kind == "heat":  # the field's CPU seconds (its info holds wall seconds only)
         import htetro_opt.solvers.grid_paths._heat as heat_module
@@ -290,7 +306,7 @@ def weighted():
     print()
 
 
-def end_to_end(n: int = 1000, pairs: int = 3):
+def end_to_end(n: int | str = 1000, pairs: int = 3):
     """Heat and the point-robot baseline alternated in fresh processes; medians and pairwise ratios."""
     load_before = os.getloadavg()
     runs = {"heat": [], "point": []}
@@ -307,7 +323,8 @@ def end_to_end(n: int = 1000, pairs: int = 3):
     ratio = statistics.median(h["cpu_s"] / p["cpu_s"] for h, p in zip(heat, point))
     wall_ratio = statistics.median(h["wall_s"] / p["wall_s"] for h, p in zip(heat, point))
     share = statistics.median(h["field_cpu_s"] / h["cpu_s"] for h in heat)
-    print(f"## End to end, {n} x {n} (median of {pairs} fresh-process runs each, heat and baseline in turn; "
+    name = f"{n} x {n}" if isinstance(n, int) else n
+    print(f"## End to end, {name} (median of {pairs} fresh-process runs each, heat and baseline in turn; "
           f"load average {load_before[0]:.1f} before, {load_after[0]:.1f} after)\n")
     print("| run | plan CPU s (min-max) | plan wall s | field CPU s (share) | process CPU s | peak RSS GB | result |")
     print("|---|---:|---:|---:|---:|---:|---|")
@@ -329,10 +346,13 @@ def main():
     parser.add_argument("--skip-plans", action="store_true")
     parser.add_argument("--pairs", type=int, default=3, help="end-to-end runs of heat and of the baseline")
     parser.add_argument("--only-e2e", action="store_true", help="run part 5 only")
+    parser.add_argument("--map", action="append", default=[], help="part 5 also on this ROS map YAML (repeatable)")
     args = parser.parse_args()
     sizes = [int(v) for v in args.sizes.split(",")]
     if args.only_e2e:
         end_to_end(pairs=args.pairs)
+        for path in args.map:
+            end_to_end(path, pairs=args.pairs)
         return
     fields(sizes)
     if not args.skip_plans:
@@ -340,6 +360,8 @@ def main():
     quality(args.clutter)
     weighted()
     end_to_end(pairs=args.pairs)
+    for path in args.map:
+        end_to_end(path, pairs=args.pairs)
 
 
 if __name__ == "__main__":
