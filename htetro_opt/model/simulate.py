@@ -47,7 +47,8 @@ from htetro_opt.model.sweeps import SweepTables, sweep_tables
 from htetro_opt.model.workspace import Workspace, check_workspace, describe_cells
 
 __all__ = ["Simulator", "SimulationResult", "simulate", "MEMORY_BUDGET", "memory_budget", "table_shape",
-           "compile_bytes", "cells_within", "map_text", "size_text", "check_memory", "transitions_at", "budget_of"]
+           "compile_bytes", "cells_within", "map_text", "size_text", "check_memory", "transitions_at", "budget_of",
+           "replay", "Replay"]
 
 _STOP = command_id("stop")
 
@@ -437,6 +438,26 @@ def _pose_id(ws, n_states: int, pose) -> int:
     return int(((s * N_HEADINGS + pose.heading) * ws.height + pose.y) * ws.width + pose.x)
 
 
+def _check_pose(ws: Workspace, tables: SweepTables, n_states: int, pose, what: str, t: int | None) -> int:
+    """:meth:`Simulator.check_pose` without a simulator (:func:`replay` and the coverage layer graph use it
+    too): the pose's id, or a ConfigurationError naming ``what`` and the offending cells."""
+    pose = as_pose(pose, what)
+    try:
+        pid = _pose_id(ws, n_states, pose)
+    except ConfigurationError as err:
+        raise ConfigurationError(f"{what} {tuple(pose)}: {err}") from err
+    outside, occupied = ws.conflicts(tables.cells(shape_index(pose.shape), pose.heading, _STOP) + (pose.x, pose.y), t)
+    conflicts = outside + occupied
+    if conflicts:
+        margin = f" (with clearance {tables.clearance:g})" if tables.clearance else ""
+        when = "" if t is None else f" at time {t}"
+        raise ConfigurationError(
+            f"{what} {tuple(pose)}{margin} collides with obstacles or the map edge{when} "
+            f"at {describe_cells(conflicts)}"
+        )
+    return pid
+
+
 class Simulator:
     """Compiled transition tables of one workspace for one command set.
 
@@ -600,20 +621,7 @@ class Simulator:
             Naming ``what`` (e.g. "start") and the offending cells if the pose lies outside the map or
             collides.
         """
-        pose = as_pose(pose, what)
-        try:
-            pid = self.encode(pose)
-        except ConfigurationError as err:
-            raise ConfigurationError(f"{what} {tuple(pose)}: {err}") from err
-        conflicts = self.pose_conflicts(pid, t)
-        if conflicts:
-            margin = f" (with clearance {self.tables.clearance:g})" if self.tables.clearance else ""
-            when = "" if t is None else f" at time {t}"
-            raise ConfigurationError(
-                f"{what} {tuple(pose)}{margin} collides with obstacles or the map edge{when} "
-                f"at {describe_cells(conflicts)}"
-            )
-        return pid
+        return _check_pose(self.workspace, self.tables, self.n_states, pose, what, t)
 
     # --- simulation --------------------------------------------------------------------------
     def _local_commands(self, sequences) -> tuple[np.ndarray, np.ndarray]:
@@ -910,6 +918,142 @@ def transitions_at(
     out = _target_entries(tables, ids, n_states, h, w)[None] + (y * w + x)[:, None, None, None]
     np.copyto(out, -1, where=~valid.transpose(3, 0, 1, 2))
     return out
+
+
+@dataclass(frozen=True, eq=False)
+class Replay:
+    """Outcome of :func:`replay`: one command sequence run from one pose, as :meth:`Simulator.run` runs it.
+
+    Attributes
+    ----------
+    valid : bool
+        No command was invalid.
+    first_invalid : int
+        Index of the first invalid command, −1 if none.
+    executed : int
+        Commands executed (those before the first invalid one).
+    poses : ndarray of int, shape (executed + 1, 4)
+        (x, y, state, heading) before the first command and after each executed one.
+    final_id : int
+        The last pose's id (:meth:`Simulator.encode`'s numbering).
+    time : float
+        Total duration of the executed commands.
+    """
+
+    valid: bool
+    first_invalid: int
+    executed: int
+    poses: np.ndarray
+    final_id: int
+    time: float
+
+
+_REPLAY_CHUNK = 1 << 16
+"""Commands whose swept cells :func:`replay` checks at a time (bounds its temporary arrays)."""
+
+
+def replay(workspace: Workspace, sequence, start, *, commands: Iterable[str | int] | None = None,
+           diagonals: bool = False, timing: Timing | None = None, clearance: float = 0.0) -> Replay:
+    """Run one command sequence from one pose without compiling the :class:`Simulator`'s table.
+
+    The same outcome as ``Simulator(workspace, ...).run([sequence], start)`` on a map without moving
+    obstacles, in memory proportional to the sequence rather than to the map (the table is ~760 MB at
+    384 x 384 with Cheng et al. 2019's commands, and a run doubles it): the robot's (state, heading) and
+    B2's cell are followed through the sequence from the per-(state, heading, command) tables (the next
+    state and heading, B2's shift), then every step's swept cells (with clearance δ) are checked at once
+    against the map, MODEL.md §4's check, as the table is built from it. A command is invalid where it is
+    illegal in its state or a swept cell is off the map or blocked; the run stops there.
+
+    Parameters
+    ----------
+    workspace : Workspace
+        Its static occupancy only (the :class:`Simulator` checks moving obstacles per step).
+    sequence : sequence of int
+        Global command ids (:func:`~htetro_opt.model.parse_commands` turns tokens into ids).
+    start : Pose or int
+        The start pose (checked collision-free), or its id (:meth:`Simulator.encode`), as
+        :meth:`Simulator.run` takes it.
+    commands, diagonals, timing, clearance : keyword-only
+        As :class:`Simulator`'s.
+
+    Raises
+    ------
+    ConfigurationError
+        If the start pose collides, lies off the map or is in a state the command set does not reach.
+    UnknownCommandError
+        If a command is not in the command set.
+
+    Examples
+    --------
+    >>> from htetro_opt.model import parse_commands
+    >>> ws = Workspace(np.zeros((6, 6), dtype=bool))
+    >>> r = replay(ws, parse_commands("x+,x+,y+"), Pose(1, 2, "O", 0))
+    >>> r.valid, r.poses[-1].tolist(), r.time
+    (True, [3, 3, 1, 0], 3.0)
+    >>> replay(ws, parse_commands("x+,x+,x+,x+"), Pose(1, 2, "O", 0)).first_invalid  # the O is two cells wide
+    3
+    """
+    check_workspace(workspace)
+    ids = np.array(_resolve_commands(commands, diagonals), dtype=np.int64)
+    if timing is not None and not isinstance(timing, Timing):
+        raise ParameterError(f"timing must be a Timing or None, got {type(timing).__name__} {reprlib.repr(timing)}")
+    timing = timing if timing is not None else Timing()
+    tables = sweep_tables(clearance)
+    n_states = _states_of(ids.tolist())
+    if isinstance(start, (int, np.integer)) and not isinstance(start, (bool, np.bool_)):
+        n_poses = n_states * N_HEADINGS * workspace.height * workspace.width
+        if not 0 <= start < n_poses:
+            raise ConfigurationError(f"start pose id {start} is not a pose id of this map (0…{n_poses - 1})")
+        start_id = int(start)  # as Simulator.run takes an id: unchecked
+    else:
+        start_id = _check_pose(workspace, tables, n_states, start, "start", None)
+    seq = _command_ids(sequence, 0).astype(np.int64, copy=False)
+    allowed = np.zeros(N_COMMANDS, dtype=bool)
+    allowed[ids] = True
+    bad = (seq < 0) | (seq >= N_COMMANDS)
+    if bad.any():
+        raise UnknownCommandError(f"command id {int(seq[bad][0])} is not a command")
+    if not allowed[seq].all():
+        raise UnknownCommandError(f"command {TOKENS[int(seq[~allowed[seq]][0])]!r} is not in this command set")
+    h, w = workspace.height, workspace.width
+    n = len(seq)
+    x0, y0 = start_id % w, (start_id // w) % h
+    sh0 = start_id // (w * h)
+    # the (state, heading) after each command, followed through the tables; B2's cell is the shifts' sum
+    states, headings = np.empty(n + 1, dtype=np.int64), np.empty(n + 1, dtype=np.int64)
+    st, hd = sh0 // N_HEADINGS, sh0 % N_HEADINGS
+    states[0], headings[0] = st, hd
+    next_state, next_heading, legal = tables.next_state.tolist(), tables.next_heading.tolist(), tables.legal
+    first_illegal = n
+    for t, c in enumerate(seq.tolist()):
+        if not legal[st, c]:
+            first_illegal = t
+            states[t + 1:], headings[t + 1:] = st, hd
+            break
+        st, hd = next_state[st][c], next_heading[st][hd][c]
+        states[t + 1], headings[t + 1] = st, hd
+    xs = x0 + np.concatenate([[0], np.cumsum(tables.shift[seq, 0])])
+    ys = y0 + np.concatenate([[0], np.cumsum(tables.shift[seq, 1])])
+    first_invalid = first_illegal
+    occupied = workspace.occupancy
+    for lo in range(0, first_illegal, _REPLAY_CHUNK):  # the swept cells of each step, from its start pose
+        hi = min(first_illegal, lo + _REPLAY_CHUNK)
+        offsets = tables.offsets[states[lo:hi], headings[lo:hi], seq[lo:hi]]  # (m, K, 2)
+        px, py = xs[lo:hi, None] + offsets[..., 0], ys[lo:hi, None] + offsets[..., 1]
+        free = (px >= 0) & (px < w) & (py >= 0) & (py < h)
+        free &= ~occupied[py.clip(0, h - 1), px.clip(0, w - 1)]
+        ok = free.all(axis=1)
+        if not ok.all():
+            first_invalid = lo + int(np.argmin(ok))
+            break
+    executed = first_invalid
+    poses = np.stack([xs, ys, states, headings], axis=1)[: executed + 1]
+    durations = timing.durations()[seq][None, :]  # summed as Simulator.run sums its (1, L) row
+    durations[:, executed:] = 0.0
+    x, y, s_, hd_ = (int(v) for v in poses[-1])
+    return Replay(valid=executed == n, first_invalid=-1 if executed == n else executed, executed=executed,
+                  poses=poses, final_id=((s_ * N_HEADINGS + hd_) * h + y) * w + x,
+                  time=float(durations.sum(axis=1)[0]))
 
 
 def _check_cells(cells, workspace: Workspace) -> np.ndarray:

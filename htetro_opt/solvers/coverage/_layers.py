@@ -11,8 +11,9 @@ The workspace graph has one vertex per (layer, B2 cell) whose footprint is free,
 between two layers, costing the fewest of Cheng et al. 2019's block commands (``1l`` … ``4r``, B2 fixed)
 that take one layer to the other through any of the 23 states × 4 headings with every step valid
 there. Those costs come from one breadth-first search per layer over the simulator's own transition
-table, for every cell at once (a block command's target state and heading do not depend on the
-cell). On the free plane: vI ↔ hI 1 command, vI ↔ O 2, O ↔ hI 3.
+table's rows (:func:`~htetro_opt.model.simulate.transitions_at`, a few thousand free cells at a time:
+the whole table is ~760 MB at 384 x 384), for every cell of a chunk at once (a block command keeps B2
+on its cell). On the free plane: vI ↔ hI 1 command, vI ↔ O 2, O ↔ hI 3.
 
 Table 1 of the paper lists other command counts for these switches (its q_c column and eq. 5); its
 §IV-C text (vI → hI one ``2r``, vI → O two ``3r``) is what the model's commands give, and wins.
@@ -31,9 +32,10 @@ import numpy as np
 from scipy.sparse import csr_matrix
 
 from htetro_opt.errors import PlanningError, UnknownShapeError
-from htetro_opt.model.commands import SEED004_COMMANDS, command_id
-from htetro_opt.model.robot import FOOTPRINTS, Pose, shape_index
-from htetro_opt.model.simulate import Simulator
+from htetro_opt.model.commands import SEED004_COMMANDS, command_id, command_set
+from htetro_opt.model.robot import FOOTPRINTS, N_HEADINGS, N_STATES, Pose, shape_index
+from htetro_opt.model.simulate import Simulator, _check_pose, transitions_at
+from htetro_opt.model.sweeps import sweep_tables
 from htetro_opt.model.workspace import Workspace, check_workspace
 
 __all__ = ["Layer", "LayerGraph", "parse_layers", "workspace_graph", "stripe_graph", "MOVES", "SWITCH_COMMANDS"]
@@ -44,6 +46,9 @@ SWITCH_COMMANDS = ("1l", "1r", "2l", "2r", "3l", "3r", "4l", "4r")
 """Cheng et al. 2019's block commands, in its Table 1 order: the order that breaks ties between switch paths."""
 _SHIFTS = {"x+": (1, 0), "x-": (-1, 0), "y+": (0, 1), "y-": (0, -1)}
 _ALIASES = {"O": ("O", 0), "vI": ("I", 0), "hI": ("I", 3)}
+_CHUNK_CELLS = 4096
+"""Free cells whose rows of the transition table (23 states x 4 headings x 13 commands, int64: ~9.6 KB a
+cell) are computed and searched at a time: the layer graph never holds the whole table (~760 MB at 384 x 384)."""
 _FORMS = "O, vI, hI or SHAPE@H (a shape of I O L J Z S T and a heading 0-3, e.g. L@1)"
 
 
@@ -127,7 +132,9 @@ class LayerGraph:
     Attributes
     ----------
     sim : Simulator
-        Compiled on Cheng et al. 2019's 13 commands; every edge is one of its valid transitions.
+        On Cheng et al. 2019's 13 commands, compiled on first use: every edge is one of its valid
+        transitions, found from its table's rows at a few thousand cells at a time
+        (:func:`~htetro_opt.model.simulate.transitions_at`), never the whole table.
     layers : tuple of Layer
     valid : ndarray of bool, shape (L, H, W)
         The layer's pose with B2 on the cell is free.
@@ -152,31 +159,33 @@ class LayerGraph:
         check_workspace(workspace)
         self.layers = parse_layers(layers)
         self.workspace = workspace
-        self.sim = Simulator(workspace, commands=SEED004_COMMANDS, clearance=clearance)
-        sim = self.sim
+        self.clearance = clearance
+        self.tables = sweep_tables(clearance)
+        self.command_ids = np.array(command_set(tokens=SEED004_COMMANDS), dtype=np.int64)
         self.width, self.height = workspace.width, workspace.height
         hw = self.width * self.height
         self.n_layers = L = len(self.layers)
         self.n_nodes = L * hw
-        nxt = sim.next
         self._pose_base = np.array([(layer.state * 4 + layer.heading) * hw for layer in self.layers], dtype=np.int64)
-        ids = self._pose_base[:, None] + np.arange(hw)[None, :]  # (L, HW) simulator pose ids
-        self._pose_ids = ids.reshape(-1)
+        self._pose_ids = (self._pose_base[:, None] + np.arange(hw)[None, :]).reshape(-1)  # simulator pose ids
 
         def column(token: str) -> int:
-            return int(sim.local[command_id(token)])
+            return int(np.flatnonzero(self.command_ids == command_id(token))[0])
 
-        dead = sim.dead
-        valid = nxt[ids, column("stop")] != dead
-        self.valid = valid.reshape(L, self.height, self.width)
-        self.move = np.stack([(nxt[ids, column(t)] != dead) & valid for t in MOVES], axis=1).reshape(
-            L, 4, self.height, self.width)
+        self._stop, self._moves = column("stop"), [column(t) for t in MOVES]
         self._switch_columns = [column(t) for t in SWITCH_COMMANDS]
+        self._cell_rows: dict = {}  # cell -> its transitions, for switch_tokens
+        valid = np.zeros((L, hw), dtype=bool)
+        move = np.zeros((L, 4, hw), dtype=bool)
         cost = np.full((L, L, hw), -1, dtype=np.int64)
-        for a in range(L):
-            dist = self._block_distances(ids[a][valid[a]])
-            for b in range(L):
-                cost[a, b] = np.where(valid[b], dist[ids[b]], -1)
+        # B2's cell is one of every pose's cells: only free cells have a valid pose, and a block command keeps
+        # B2 where it is, so each cell's switches are its own (the chunks are independent)
+        free = np.flatnonzero(~workspace.occupancy.reshape(-1))
+        for lo in range(0, len(free), _CHUNK_CELLS):
+            cells = free[lo:lo + _CHUNK_CELLS]
+            self._chunk(cells, valid, move, cost)
+        self.valid = valid.reshape(L, self.height, self.width)
+        self.move = move.reshape(L, 4, self.height, self.width)
         self.switch_cost = cost.reshape(L, L, self.height, self.width)
         xs, ys = np.meshgrid(np.arange(self.width), np.arange(self.height))
         fp = np.stack([FOOTPRINTS[layer.state, layer.heading] for layer in self.layers])  # (L, 4, 2)
@@ -185,16 +194,50 @@ class LayerGraph:
         self.footprint = (fy.clip(0, self.height - 1) * self.width + fx.clip(0, self.width - 1)).reshape(-1, 4)
         self._fy = fy.reshape(-1, 4)
 
-    def _block_distances(self, sources: np.ndarray) -> np.ndarray:
-        """Fewest block commands from any source pose to every pose of its cell (−1: none), B2 fixed."""
-        nxt, dead = self.sim.next, self.sim.dead
-        dist = np.full(self.sim.n_poses + 1, -1, dtype=np.int64)
+    def _rows(self, cells: np.ndarray) -> np.ndarray:
+        """The simulator's ``next`` rows at some flat cells, shape (n, states, 4, commands), −1 where dead
+        (:func:`~htetro_opt.model.simulate.transitions_at`: the same sweep check as the table's)."""
+        xy = np.column_stack([cells % self.width, cells // self.width])
+        return transitions_at(self.workspace, xy, commands=SEED004_COMMANDS, clearance=self.clearance)
+
+    def _chunk(self, cells: np.ndarray, valid, move, cost) -> None:
+        """``valid``, ``move`` and ``switch_cost`` at some free cells, from their rows of the transition table:
+        one breadth-first search over the block commands per source layer, every cell of the chunk at once."""
+        rows = self._rows(cells)  # (n, S, 4, C)
+        n, n_states = rows.shape[:2]
+        per_cell = n_states * N_HEADINGS
+        hw = self.width * self.height
+        states = [(layer.state, layer.heading) for layer in self.layers]
+        for a, (s, h) in enumerate(states):
+            valid[a, cells] = rows[:, s, h, self._stop] >= 0
+            for d, c in enumerate(self._moves):
+                move[a, d, cells] = (rows[:, s, h, c] >= 0) & valid[a, cells]
+        switch = rows[..., self._switch_columns].reshape(n, per_cell, len(self._switch_columns))
+        if ((switch >= 0) & (switch % hw != cells[:, None, None])).any():
+            raise PlanningError("internal error: a block command moved B2 off its cell")
+        local = np.where(switch >= 0, np.arange(n)[:, None, None] * per_cell + switch // hw, -1).reshape(
+            n * per_cell, -1)
+        dead = n * per_cell
+        local[local < 0] = dead
+        local = np.vstack([local, np.full((1, local.shape[1]), dead)])
+        ids = np.arange(n) * per_cell
+        for a, (s, h) in enumerate(states):
+            sources = ids[valid[a, cells]] + s * N_HEADINGS + h
+            dist = self._block_distances(local, sources, dead)
+            for b, (s2, h2) in enumerate(states):
+                cost[a, b, cells] = np.where(valid[b, cells], dist[ids + s2 * N_HEADINGS + h2], -1)
+
+    @staticmethod
+    def _block_distances(local: np.ndarray, sources: np.ndarray, dead: int) -> np.ndarray:
+        """Fewest block commands from any source pose to every pose of its cell (−1: none), B2 fixed;
+        ``local`` the chunk's switch transitions in its own pose numbers (``dead``: none)."""
+        dist = np.full(dead + 1, -1, dtype=np.int64)
         dist[sources] = 0
         frontier, k = sources, 0
         fresh = np.zeros(len(dist), dtype=bool)
         while len(frontier):
             k += 1
-            reached = nxt[frontier][:, self._switch_columns].ravel()
+            reached = local[frontier].ravel()
             reached = reached[reached != dead]
             reached = reached[dist[reached] < 0]
             dist[reached] = k
@@ -203,6 +246,23 @@ class LayerGraph:
             frontier = np.flatnonzero(fresh)
             fresh[frontier] = False
         return dist[:-1]
+
+    @cached_property
+    def sim(self) -> Simulator:
+        """The map's :class:`~htetro_opt.model.Simulator` on Cheng et al. 2019's 13 commands, compiled on
+        first use (the tiling-tsp baseline's legs; the planner itself needs only rows of its table, and the
+        whole table is (92 poses a cell x cells + 1) x 14 int32, ~760 MB at 384 x 384, twice that once run)."""
+        return Simulator(self.workspace, commands=SEED004_COMMANDS, clearance=self.clearance)
+
+    def check_pose(self, pose, what: str = "pose") -> int:
+        """The simulator's check of a pose (inside the map, collision-free), without compiling it: its pose id.
+
+        Raises
+        ------
+        ConfigurationError
+            Naming ``what`` and the offending cells.
+        """
+        return _check_pose(self.workspace, self.tables, N_STATES, pose, what, None)
 
     # --- vertices ------------------------------------------------------------------------------
     def node(self, layer: int, x: int, y: int) -> int:
@@ -300,18 +360,25 @@ class LayerGraph:
             If no valid switch exists there.
         """
         x, y = (int(c) for c in cell)
-        start = int(self._pose_base[a]) + y * self.width + x
-        goal = int(self._pose_base[b]) + y * self.width + x
-        nxt, dead = self.sim.next, self.sim.dead
+        flat = y * self.width + x
+        rows = self._cell_rows.get(flat)
+        if rows is None:
+            if len(self._cell_rows) > 4096:
+                self._cell_rows.clear()
+            rows = self._cell_rows[flat] = self._rows(np.array([flat]))[0].reshape(-1, len(self.command_ids))
+        hw = self.width * self.height
+        # poses of this cell by (state, heading): a block command keeps B2 on it (the table's rows, −1 dead)
+        start = self.layers[a].state * N_HEADINGS + self.layers[a].heading
+        goal = self.layers[b].state * N_HEADINGS + self.layers[b].heading
         parent = {start: None}
         queue = deque([start])
         while queue and goal not in parent:
             p = queue.popleft()
             for token, col in zip(SWITCH_COMMANDS, self._switch_columns):
-                q = int(nxt[p, col])
-                if q != dead and q not in parent:
-                    parent[q] = (p, token)
-                    queue.append(q)
+                q = int(rows[p, col])
+                if q >= 0 and q // hw not in parent:
+                    parent[q // hw] = (p, token)
+                    queue.append(q // hw)
         if goal not in parent:
             raise PlanningError(f"no switch from layer {self.layers[a].name} to {self.layers[b].name} at ({x}, {y})")
         tokens = []
