@@ -207,7 +207,15 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
         used_stripes = ()
         mopup = True
     lanes = len(path) - 1
-    added = mop_up(lg, path, cov.coverable, cov.reachable, order=options["mopup"], goal=goal_node) if mopup else []
+    # the mop-up within the time limit, less a twentieth of it for the commands and the replay (what it cuts is
+    # said in time_limit_cut: cells left uncovered, the sequencing skipped)
+    mop_deadline = None if time_limit is None else began + 0.95 * time_limit
+    mop_cut: dict = {}
+    added = mop_up(lg, path, cov.coverable, cov.reachable, order=options["mopup"], goal=goal_node,
+                   deadline=mop_deadline, cut=mop_cut) if mopup else []
+    if mop_cut:
+        extras["time_limited"] = True
+        extras["info"]["time_limit_cut"] = {**extras["info"].get("time_limit_cut", {}), **mop_cut}
     mopup_path = [path[-1]] + added
     tail = []
     if goal_node is not None and mopup_path[-1] != goal_node:

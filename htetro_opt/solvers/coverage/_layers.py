@@ -363,9 +363,8 @@ class LayerGraph:
         flat = y * self.width + x
         rows = self._cell_rows.get(flat)
         if rows is None:
-            if len(self._cell_rows) > 4096:
-                self._cell_rows.clear()
-            rows = self._cell_rows[flat] = self._rows(np.array([flat]))[0].reshape(-1, len(self.command_ids))
+            self._fetch(np.array([flat]))
+            rows = self._cell_rows[flat]
         hw = self.width * self.height
         # poses of this cell by (state, heading): a block command keeps B2 on it (the table's rows, −1 dead)
         start = self.layers[a].state * N_HEADINGS + self.layers[a].heading
@@ -374,8 +373,7 @@ class LayerGraph:
         queue = deque([start])
         while queue and goal not in parent:
             p = queue.popleft()
-            for token, col in zip(SWITCH_COMMANDS, self._switch_columns):
-                q = int(rows[p, col])
+            for token, q in zip(SWITCH_COMMANDS, rows[p].tolist()):
                 if q >= 0 and q // hw not in parent:
                     parent[q // hw] = (p, token)
                     queue.append(q // hw)
@@ -387,11 +385,30 @@ class LayerGraph:
             tokens.append(token)
         return tokens[::-1]
 
+    def _fetch(self, cells: np.ndarray) -> None:
+        """The block commands' rows of the transition table at some cells, for :meth:`switch_tokens`: one
+        :func:`~htetro_opt.model.simulate.transitions_at` call for them all (its set-up, ~5 ms, was most of
+        a call for one cell), int32, the cache emptied first when it is full."""
+        if len(self._cell_rows) + len(cells) > _CHUNK_CELLS:
+            self._cell_rows.clear()
+        rows = self._rows(cells)[..., self._switch_columns].astype(np.int32)
+        rows = rows.reshape(len(cells), -1, len(self._switch_columns))
+        self._cell_rows.update(zip(cells.tolist(), rows))
+
     def commands_of(self, path: list[int]) -> list[str]:
         """The command tokens that drive a vertex path."""
         tokens: list[str] = []
-        for u, v in zip(path[:-1], path[1:]):
-            tokens += self.edge_tokens(u, v)
+        hw = self.width * self.height
+        step = _CHUNK_CELLS // 2
+        for lo in range(0, len(path) - 1, step):
+            part = np.asarray(path[lo:lo + step + 1], dtype=np.int64)
+            switch = (part[:-1] // hw != part[1:] // hw) & (part[:-1] % hw == part[1:] % hw)
+            cells = np.unique(part[:-1][switch] % hw)
+            cells = cells[[c not in self._cell_rows for c in cells.tolist()]] if len(cells) else cells
+            if len(cells):
+                self._fetch(cells)
+            for u, v in zip(part[:-1].tolist(), part[1:].tolist()):
+                tokens += self.edge_tokens(u, v)
         return tokens
 
 

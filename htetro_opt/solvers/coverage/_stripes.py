@@ -196,13 +196,16 @@ def _walk_back(pred, source: int, target: int) -> list[int]:
 
 
 def _nearest_first(lg: LayerGraph, path: list[int], target: np.ndarray, reachable: np.ndarray,
-                   covered: np.ndarray) -> tuple[list[int], list[int]]:
+                   covered: np.ndarray, deadline: float | None = None) -> tuple[list[int], list[int]]:
     """Extend from ``path[-1]``: each time to the nearest vertex covering an uncovered target cell
-    (ties: the lower vertex number). Returns (the added vertices, the vertices gone to). Updates ``covered``."""
+    (ties: the lower vertex number), stopping early past ``deadline``. Returns (the added vertices, the
+    vertices gone to). Updates ``covered``."""
     added: list[int] = []
     goals: list[int] = []
     cur = path[-1]
     while (target & ~covered).any():
+        if deadline is not None and time.perf_counter() > deadline:
+            break
         useful = reachable & (target & ~covered)[lg.footprint].any(axis=1)
         dist, pred = dijkstra(lg.matrix, indices=cur, return_predecessors=True)
         cost = np.where(useful, dist, np.inf)
@@ -218,7 +221,8 @@ def _nearest_first(lg: LayerGraph, path: list[int], target: np.ndarray, reachabl
 
 
 def mop_up(lg: LayerGraph, path: list[int], coverable: np.ndarray, reachable: np.ndarray, *,
-           order: str = "sequenced", goal: int | None = None) -> list[int]:
+           order: str = "sequenced", goal: int | None = None, deadline: float | None = None,
+           cut: dict | None = None) -> list[int]:
     """Extend a vertex path until every coverable cell is under a visited footprint.
 
     ``"nearest"``: each time to the nearest vertex covering an uncovered cell (ties: the lower
@@ -228,12 +232,26 @@ def mop_up(lg: LayerGraph, path: list[int], coverable: np.ndarray, reachable: np
     driven by shortest legs, skipping a vertex whose cells are covered by then and finishing
     nearest-first if the new legs left a cell; the cheaper of the two walks is kept, counting the
     return to ``goal`` if there is one (ties: the nearest-first one), so the sequenced mop-up never
-    costs more."""
+    costs more.
+
+    ``deadline`` (``time.perf_counter()`` seconds): the nearest-first walk stops there, leaving cells
+    uncovered, and the sequencing is skipped (the nearest-first walk kept) when it would not end by
+    then (about twice the nearest-first walk's time: its legs' searches, then the walk along the new
+    order); ``cut`` then records what was cut (``mopup_cells_left``, ``mopup_sequencing_skipped``)."""
     target = coverable.reshape(-1)
     base = np.zeros(lg.width * lg.height, dtype=bool)
     base[lg.footprint[path].ravel()] = True
-    added, goals = _nearest_first(lg, path, target, reachable, base.copy())
+    began = time.perf_counter()
+    covered = base.copy()
+    added, goals = _nearest_first(lg, path, target, reachable, covered, deadline)
+    left = int((target & ~covered).sum())
+    if left and cut is not None:
+        cut["mopup_cells_left"] = left
     if order == "nearest" or len(goals) < 3:  # two waypoints have one order from a fixed start
+        return added
+    if deadline is not None and (left or time.perf_counter() + 2 * (time.perf_counter() - began) > deadline):
+        if cut is not None:
+            cut["mopup_sequencing_skipped"] = True
         return added
     nodes = [path[-1]] + goals
     # the legs between them, 64 sources at a time: all at once held len(nodes) rows of the whole graph
@@ -245,13 +263,17 @@ def mop_up(lg: LayerGraph, path: list[int], coverable: np.ndarray, reachable: np
         return added
     covered, cur, walk = base.copy(), path[-1], []
     for i in better.tolist()[1:]:
-        goal = nodes[i]
-        if not (target & ~covered)[lg.footprint[goal]].any():
+        if deadline is not None and time.perf_counter() > deadline:  # the nearest-first walk covers them all
+            if cut is not None:
+                cut["mopup_sequencing_skipped"] = True
+            return added
+        goal_i = nodes[i]
+        if not (target & ~covered)[lg.footprint[goal_i]].any():
             continue
-        _, leg = shortest_path(lg, cur, goal)
+        _, leg = shortest_path(lg, cur, goal_i)
         covered[lg.footprint[leg].ravel()] = True
         walk += leg[1:]
-        cur = goal
+        cur = goal_i
     rest, _ = _nearest_first(lg, [cur], target, reachable, covered)
     walk += rest
     def cost(w: list[int]) -> float:
@@ -285,11 +307,12 @@ class _Dag:
     same heap of (distance, insertion count, node), the same relaxation order and first-found
     predecessor), so the path it picks among equal ones is networkx's."""
 
-    __slots__ = ("adj", "edge_count")
+    __slots__ = ("adj", "edge_count", "stopped")
 
     def __init__(self) -> None:
         self.adj: dict = {}
         self.edge_count = 0
+        self.stopped = False  # the last shortest_path was stopped (``stop``) before reaching its target
 
     def _successors(self, u, v) -> dict:
         """``u``'s successors, both nodes added first if new (in insertion order, as networkx)."""
@@ -328,21 +351,31 @@ class _Dag:
     def number_of_edges(self) -> int:
         return self.edge_count
 
-    def shortest_path(self, source, target, weight) -> tuple[float, list] | None:
+    def shortest_path(self, source, target, weight, stop=None, progress=None) -> tuple[float, list] | None:
         """(distance, nodes) of the cheapest source → target path, ``weight(u, v, data)`` giving each
-        edge's cost (None: hidden); None when there is none."""
+        edge's cost (None: hidden); None when there is none.
+
+        ``stop()`` (checked every 32 nodes settled) ends the search early: the path returned is then the
+        cheapest to the settled node of greatest ``progress(node)`` (ties: the nearer, then the first
+        settled), and :attr:`stopped` is set. Without a stop the search is networkx's, step for step."""
         adj = self.adj
         dist: dict = {}
         seen = {source: 0}
         pred: dict = {}
         c = itertools.count()
         fringe = [(0, next(c), source)]
+        self.stopped = False
+        settled = 0
         while fringe:
             d, _, v = heapq.heappop(fringe)
             if v in dist:
                 continue
             dist[v] = d
             if v == target:
+                break
+            settled += 1
+            if stop is not None and settled % 32 == 0 and stop():
+                self.stopped = True
                 break
             for u, e in adj[v].items():
                 cost = weight(v, u, e)
@@ -356,7 +389,9 @@ class _Dag:
                     seen[u] = du
                     heapq.heappush(fringe, (du, next(c), u))
                     pred[u] = v
-        if target not in dist:
+        if self.stopped:  # dicts keep insertion order: max() keeps the first settled of equal keys
+            target = max(dist, key=lambda n: (progress(n), -dist[n]))
+        elif target not in dist:
             return None
         path = [target]
         while path[-1] in pred:
@@ -621,9 +656,22 @@ class _Planner:
             left.discard(i)
             if not left:
                 return order
-            dist = dijkstra(matrix, indices=ports[here][1], min_only=True)
+            dist = self._nearest(ports[here][1], [ports[(j, e)][0] for j in left for e in (1, -1)])
             here = min(((j, e) for j in left for e in (1, -1)),
                        key=lambda k: (dist[ports[k][0]].min(), sweeps[k[0]].stripe, k[1] == d, k[0]))
+
+    def _nearest(self, sources: list[int], targets: list[list[int]]) -> np.ndarray:
+        """Distances from the nearest of ``sources``, exact up to the nearest of ``targets`` at least: the
+        search bounded at 64, 256, 1,024 commands, then the whole map, stopping at the first bound within
+        which a target lies (the distances within a bound are the whole search's; beyond it they are
+        infinite, and no target there can be the nearest). A search over the whole map per sweep was
+        quadratic in the map's size: most of the set-up's time on malaga_building."""
+        ids = np.unique(np.concatenate([np.asarray(t, dtype=np.int64) for t in targets])) if targets else []
+        for limit in (64, 256, 1024, np.inf):
+            dist = dijkstra(self.lg.matrix, indices=sources, min_only=True, limit=limit)
+            if not len(ids) or np.isfinite(dist[ids]).any():
+                return dist
+        return dist
 
     def _translations(self, layer: int, rows: tuple[int, int]):
         hw = self.lg.width * self.lg.height
@@ -912,6 +960,7 @@ class _Planner:
         (v = −1: a free end); then "G" (the goal vertex, or a free end when None). A sweep's chains
         (its cut grids and, with ``ends="both"``, both directions) run in parallel between its ports."""
         g = _Dag()
+        self._chain = chain
         blocks_seen: dict = {}  # this DAG's blocks -> their edges if the time limit prices them (_past_cutoff)
         last = len(chain) - 1
         first = chain[0]
@@ -977,7 +1026,32 @@ class _Planner:
 
         if "S" not in g or "G" not in g:
             return None, None
-        found = g.shortest_path("S", "G", weight)
+        # the greedy walks past the cutoff (_past_cutoff) are priced one by one too: past the deadline, less a
+        # twentieth of the time allowed (the commands and the replay), the search stops where it has got to
+        stop = progress = None
+        if self.deadline is not None and self.fallback:
+            end = self.deadline - 0.05 * (self.deadline - self.began)
+            lengths = {s: {k: len(v[0]) + 1 for k, v in sweep.layouts.items()} for s, sweep in enumerate(self._chain)}
+
+            def stop() -> bool:
+                return time.perf_counter() > end
+
+            def progress(n):  # how far along the chain of sweeps a node is
+                if n == "S":
+                    return (-1, 0, 0.0)
+                if n[0] == "in":
+                    return (n[1], 0, 0.0)
+                if n[0] == "out":
+                    return (n[1], 2, 0.0)
+                return (n[0], 1, n[2] / lengths[n[0]][n[1]])
+
+        found = g.shortest_path("S", "G", weight, stop=stop, progress=progress)
+        if g.stopped:
+            self.time_limited = True
+            last = found[1][-1]
+            reached = -1 if last == "S" else last[1] if last[0] in ("in", "out") else last[0]
+            self.cut["dag_stopped"] = {"sweeps": len(self._chain), "sweeps_entered": reached + 1,
+                                       "last_node": list(last) if isinstance(last, tuple) else last}
         if found is None:
             return None, None
         weighted, path = found
@@ -1005,7 +1079,7 @@ class _Planner:
                     self._regions(sweep)
             g = self.dag([sweep for sweep, _ in order], start=self.start, goal=self.goal)
             found, dag_path = self._solve(g)
-            if found is None:
+            if found is None or g.stopped:  # a path cut short by the deadline is no candidate order
                 return math.inf
             return plan_total(self.lg, self.cov, self._vertex_path(g, dag_path), found, self.goal, self.mopup)
 
@@ -1172,7 +1246,8 @@ def plan_stripes(lg: LayerGraph, cov: Coverability, start: int, goal: int | None
                 "unpriced_edges": sum(c["hidden_edges"] for c, _ in cuts),
                 "failed_regions": sum(c["failed_regions"] for c, _ in cuts),
                 "candidates_skipped": skipped, "order_search_cut": any(late for _, late in cuts)
-                and reorder and 2 <= sweeps <= ORDER_SWEEPS}
+                and reorder and 2 <= sweeps <= ORDER_SWEEPS,
+                "dag_stopped": next((c["dag_stopped"] for c, _ in cuts if "dag_stopped" in c), None)}
         return best
 
     if len(runs) == 1:

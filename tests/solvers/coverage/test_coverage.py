@@ -403,9 +403,14 @@ def test_callable_method_is_revalidated():
 
 
 def test_time_limit_is_a_result_not_an_error():
+    # a deadline already passed: the DAG's search stops where it is and the mop-up is cut, both said; the
+    # partial plan re-validates (finish_coverage) and the cells it leaves are those the cut says
     ws = load_scenario("coverage_16x16").workspace
     plan = plan_coverage(ws, "O,vI,hI", time_limit=1e-6)
-    assert plan.time_limited and plan.complete
+    cut = plan.info["time_limit_cut"]
+    assert plan.time_limited and cut["dag_stopped"] is not None
+    assert cut.get("mopup_cells_left", 0) == int((plan.coverable & ~plan.covered).sum())
+    assert plan.success == (cut.get("mopup_cells_left", 0) == 0)
 
 
 def test_past_the_time_limit_no_sweep_order_is_tried_and_no_second_candidate_planned(monkeypatch):
@@ -418,7 +423,7 @@ def test_past_the_time_limit_no_sweep_order_is_tried_and_no_second_candidate_pla
     monkeypatch.setattr(_stripes._Planner, "plan", lambda self: planned.append(self.widening) or plan_one(self))
     ws = load_scenario("coverage_16x16").workspace
     plan = plan_coverage(ws, "O,vI,hI", time_limit=1e-6)
-    assert plan.time_limited and plan.complete
+    assert plan.time_limited
     assert plan.info["order_tries"] == 0 and len(planned) == 1
     planned.clear()
     unlimited = plan_coverage(ws, "O,vI,hI")  # the same map without a limit: orders tried, both widenings

@@ -116,18 +116,40 @@ def test_past_the_time_limit_the_paper_mode_builds_no_region_problem(spies, monk
     check(ws, plan)
 
 
+def _cut_at_once(self):
+    """_Planner._past_cutoff past its cutoff from the start, the deadline itself far away (no clock read)."""
+    self.time_limited = True
+    return True
+
+
 def test_past_the_time_limit_ours_walks_one_chain_greedily_and_says_what_was_cut(monkeypatch):
-    # no search and no full problem: light problems, one greedy walk per region of one chain; the plan
-    # still covers every coverable cell (the mop-up) and re-validates
+    # past the cutoff (the deadline not yet passed): no search and no full problem, light problems, one
+    # greedy walk per region of one chain; the plan still covers every coverable cell (the mop-up) and re-validates
     built = []
     build = _stripes._Planner._build
     monkeypatch.setattr(_stripes._Planner, "_build", lambda self, *a: built.append(a[-1]) or build(self, *a))
     monkeypatch.setattr(_stripes, "search_region", lambda *a, **k: pytest.fail("a region was searched"))
+    monkeypatch.setattr(_stripes._Planner, "_past_cutoff", _cut_at_once)
     ws = load_scenario("coverage_16x16").workspace
-    plan = plan_coverage(ws, "O,vI,hI", time_limit=1e-6)
+    plan = plan_coverage(ws, "O,vI,hI", time_limit=10**6)
     cut = plan.info["time_limit_cut"]
     assert plan.time_limited and plan.success and built and all(built) and plan.regions_optimal == 0
     assert cut["greedy_regions"] > 0 and cut["unpriced_edges"] > 0 and cut["candidates_skipped"]
+    assert cut["dag_stopped"] is None and "mopup_cells_left" not in cut
+    check(ws, plan)
+
+
+def test_past_the_deadline_ours_stops_the_dag_and_the_mopup_and_says_so():
+    # a deadline already passed: the DAG's search stops after its first few nodes, its path ends at the
+    # furthest node it settled, and the mop-up covers nothing more; the plan re-validates (check) and what
+    # it leaves uncovered is what time_limit_cut says
+    ws = load_scenario("coverage_16x16").workspace
+    plan = plan_coverage(ws, "O,vI,hI", time_limit=1e-9)
+    cut = plan.info["time_limit_cut"]
+    stopped = cut["dag_stopped"]
+    assert plan.time_limited and stopped["sweeps"] == plan.info["sweeps"] and stopped["sweeps_entered"] <= stopped["sweeps"]
+    left = int((plan.coverable & ~plan.covered).sum())
+    assert left > 0 and cut["mopup_cells_left"] == left and not plan.success
     check(ws, plan)
 
 def test_ours_lists_every_addition_and_the_paper_none():
