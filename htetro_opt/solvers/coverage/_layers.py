@@ -213,19 +213,27 @@ class LayerGraph:
             for d, c in enumerate(self._moves):
                 move[a, d, cells] = (rows[:, s, h, c] >= 0) & valid[a, cells]
         switch = rows[..., self._switch_columns].reshape(n, per_cell, len(self._switch_columns))
-        if ((switch >= 0) & (switch % hw != cells[:, None, None])).any():
+        ok = switch >= 0
+        if (ok & (switch % hw != cells[:, None, None])).any():
             raise PlanningError("internal error: a block command moved B2 off its cell")
-        local = np.where(switch >= 0, np.arange(n)[:, None, None] * per_cell + switch // hw, -1).reshape(
-            n * per_cell, -1)
-        dead = n * per_cell
+        # a block command's target (state, heading) does not depend on the cell, only whether it is valid there:
+        # cells with the same valid block commands have the same switch costs, searched once (most of a map's
+        # cells are open floor, one pattern)
+        packed = np.packbits(ok.reshape(n, -1), axis=1)
+        keys = np.ascontiguousarray(packed).view(np.dtype((np.void, packed.shape[1]))).ravel()
+        _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+        inverse = inverse.ravel()
+        n_patterns = len(first)
+        local = np.where(ok[first], np.arange(n_patterns)[:, None, None] * per_cell + switch[first] // hw, -1).reshape(
+            n_patterns * per_cell, -1)
+        dead = n_patterns * per_cell
         local[local < 0] = dead
         local = np.vstack([local, np.full((1, local.shape[1]), dead)])
-        ids = np.arange(n) * per_cell
+        ids = inverse * per_cell
         for a, (s, h) in enumerate(states):
-            sources = ids[valid[a, cells]] + s * N_HEADINGS + h
-            dist = self._block_distances(local, sources, dead)
+            dist = self._block_distances(local, np.arange(n_patterns) * per_cell + s * N_HEADINGS + h, dead)
             for b, (s2, h2) in enumerate(states):
-                cost[a, b, cells] = np.where(valid[b, cells], dist[ids + s2 * N_HEADINGS + h2], -1)
+                cost[a, b, cells] = np.where(valid[a, cells] & valid[b, cells], dist[ids + s2 * N_HEADINGS + h2], -1)
 
     @staticmethod
     def _block_distances(local: np.ndarray, sources: np.ndarray, dead: int) -> np.ndarray:
