@@ -225,6 +225,10 @@ def plan_coverage(workspace: Workspace, layers=DEFAULT_LAYERS, *, method: str | 
     tokens_tail = lg.commands_of(tail) if tail else []
     if method == "boustrophedon":
         extras["info"] = {"lane_vertices": lanes}
-    return finish_coverage(lg, tokens_main + tokens_mop + tokens_tail, start_node, method=name, stripes=used_stripes,
+    plan = finish_coverage(lg, tokens_main + tokens_mop + tokens_tail, start_node, method=name, stripes=used_stripes,
                            goal_node=goal_node, coverable=cov, began=began, mopup_commands=len(tokens_mop),
                            transit_commands=len(tokens_tail), **extras)
+    cut = plan.info.get("time_limit_cut")
+    if cut is not None:  # what the cut left, from the replay (a switch's intermediate poses cover cells too)
+        cut["cells_left"] = len(plan.missed)
+    return plan

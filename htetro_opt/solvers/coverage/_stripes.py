@@ -237,7 +237,7 @@ def mop_up(lg: LayerGraph, path: list[int], coverable: np.ndarray, reachable: np
     ``deadline`` (``time.perf_counter()`` seconds): the nearest-first walk stops there, leaving cells
     uncovered, and the sequencing is skipped (the nearest-first walk kept) when it would not end by
     then (about twice the nearest-first walk's time: its legs' searches, then the walk along the new
-    order); ``cut`` then records what was cut (``mopup_cells_left``, ``mopup_sequencing_skipped``)."""
+    order); ``cut`` then records what was cut (``mopup_stopped``, ``mopup_sequencing_skipped``)."""
     target = coverable.reshape(-1)
     base = np.zeros(lg.width * lg.height, dtype=bool)
     base[lg.footprint[path].ravel()] = True
@@ -246,7 +246,7 @@ def mop_up(lg: LayerGraph, path: list[int], coverable: np.ndarray, reachable: np
     added, goals = _nearest_first(lg, path, target, reachable, covered, deadline)
     left = int((target & ~covered).sum())
     if left and cut is not None:
-        cut["mopup_cells_left"] = left
+        cut["mopup_stopped"] = True
     if order == "nearest" or len(goals) < 3:  # two waypoints have one order from a fixed start
         return added
     if deadline is not None and (left or time.perf_counter() + 2 * (time.perf_counter() - began) > deadline):

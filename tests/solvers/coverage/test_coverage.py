@@ -409,8 +409,8 @@ def test_time_limit_is_a_result_not_an_error():
     plan = plan_coverage(ws, "O,vI,hI", time_limit=1e-6)
     cut = plan.info["time_limit_cut"]
     assert plan.time_limited and cut["dag_stopped"] is not None
-    assert cut.get("mopup_cells_left", 0) == int((plan.coverable & ~plan.covered).sum())
-    assert plan.success == (cut.get("mopup_cells_left", 0) == 0)
+    assert cut["cells_left"] == int((plan.coverable & ~plan.covered).sum())
+    assert plan.success == (cut["cells_left"] == 0) and cut.get("mopup_stopped", False) == (cut["cells_left"] > 0)
 
 
 def test_past_the_time_limit_no_sweep_order_is_tried_and_no_second_candidate_planned(monkeypatch):

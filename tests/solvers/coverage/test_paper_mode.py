@@ -135,7 +135,7 @@ def test_past_the_time_limit_ours_walks_one_chain_greedily_and_says_what_was_cut
     cut = plan.info["time_limit_cut"]
     assert plan.time_limited and plan.success and built and all(built) and plan.regions_optimal == 0
     assert cut["greedy_regions"] > 0 and cut["unpriced_edges"] > 0 and cut["candidates_skipped"]
-    assert cut["dag_stopped"] is None and "mopup_cells_left" not in cut
+    assert cut["dag_stopped"] is None and "mopup_stopped" not in cut and cut["cells_left"] == 0
     check(ws, plan)
 
 
@@ -149,7 +149,7 @@ def test_past_the_deadline_ours_stops_the_dag_and_the_mopup_and_says_so():
     stopped = cut["dag_stopped"]
     assert plan.time_limited and stopped["sweeps"] == plan.info["sweeps"] and stopped["sweeps_entered"] <= stopped["sweeps"]
     left = int((plan.coverable & ~plan.covered).sum())
-    assert left > 0 and cut["mopup_cells_left"] == left and not plan.success
+    assert left > 0 and cut["cells_left"] == left and cut["mopup_stopped"] and not plan.success
     check(ws, plan)
 
 def test_ours_lists_every_addition_and_the_paper_none():
