@@ -20,8 +20,12 @@ scattered obstacles (:func:`scattered`: n² / 40 blocks of 1-3 x 1-3 cells at se
 alternated, CPU seconds of the whole process (what ``htetro-opt cover`` costs: imports and tables
 included) and of the planning call alone; the plan-length ratio; whether every coverable cell is
 covered (and the plan re-validates in the simulator); then the wall time, CPU and peak RSS of the
-default method on a 256 x 256 scattered map and on the bundled real map malaga_building (177 x 214),
-and with ``--large`` a 384 x 384 scattered map (``--small``: the ratio table only).
+default method and the baseline on a 256 x 256 scattered map and on the bundled real map malaga_building
+(177 x 214), with ``--large`` a 384 x 384 scattered map, and with ``--map FILE.yaml`` any ROS map_server map
+(read by :func:`~htetro_opt.scenarios.rosmap.load_ros_map`; e.g. the TurtleBot3 world map, 384 x 384 at
+5 cm, kept outside the repository) (``--small``: the ratio table only). Peak RSS is given for the planning
+(read in the child right after ``plan_coverage``) and for the whole process (the benchmark's own oracle
+replay compiles the full Simulator, ~1.5 GB at 384 x 384).
 
 The indoor room's {O} rows start at the roadmap's start (its goal lies behind a doorway the O cannot
 pass) or at the bottom-left pose, both with a free end, and their boustrophedon from the same start.
@@ -33,6 +37,7 @@ import argparse
 import json
 import math
 import os
+import resource
 import subprocess
 import sys
 import time
@@ -42,6 +47,7 @@ import numpy as np
 from htetro_opt.errors import TilingError
 from htetro_opt.model import SEED004_COMMANDS, Simulator, Workspace, sweep_tables
 from htetro_opt.scenarios import load_scenario
+from htetro_opt.scenarios.rosmap import load_ros_map
 from htetro_opt.solvers import plan_coverage
 from htetro_opt.solvers.coverage import LayerGraph
 from htetro_opt.solvers.coverage._spec import SPEC as COVERAGE_SPEC
@@ -102,13 +108,17 @@ def child(spec: str, method: str) -> None:
     if spec.startswith("scattered:"):
         n, seed = (int(v) for v in spec.split(":")[1:])
         ws = Workspace(scattered(n, seed))
+    elif spec.endswith(".yaml"):  # a ROS map_server map given with --map, through the project's loader
+        ws = Workspace(load_ros_map(spec)[0])
     else:
         ws = load_scenario(spec).workspace
     cpu, wall = time.process_time(), time.perf_counter()
     plan = plan_coverage(ws, method=method)
     cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
+    plan_rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # before the oracle's own tables
     replay = Simulator(ws, commands=SEED004_COMMANDS).run([plan.commands], plan.start)
     print(json.dumps({"cost": plan.action_cost, "plan_cpu": cpu, "plan_wall": wall, "success": plan.success,
+                      "plan_rss": plan_rss, "size": f"{ws.width} x {ws.height}", "free": int((~ws.occupancy).sum()),
                       "valid": bool(replay.valid[0] and replay.time[0] == plan.time),
                       "coverable": int(plan.coverable.sum()), "left": int((plan.coverable & ~plan.covered).sum())}))
 
@@ -152,12 +162,16 @@ def speed(repeats: int = 2, large=("scattered:256:0", "malaga_building")) -> Non
               f"| {pa['left']} of {pa['coverable']} / {pb['left']} of {pb['coverable']} | {a['rss']:.0f} |", flush=True)
     print(f"\nprocess CPU ratio stripes / boustrophedon: max {max(ratios):.2f} (target <= 4); planning alone: "
           f"{min(planning):.0f}-{max(planning):.0f}x; plan length ratio max {max(lengths):.2f} (target <= 1)\n")
-    print("| map | method | wall s | CPU s (process) | peak RSS MB | commands | every coverable cell covered |")
-    print("|---|---|---:|---:|---:|---:|---|")
+    print("| map | size, free cells | method | wall s | CPU s (process) | peak RSS MB: planning / process | commands "
+          "| every coverable cell covered |")
+    print("|---|---|---|---:|---:|---:|---:|---|")
     for spec in large:
         for method in ("stripes", "boustrophedon"):
+            if method == "boustrophedon" and spec == "scattered:384:0":
+                continue  # the baseline's whole-map Dijkstra per lane vertex: far longer than the planner there
             r = in_process(spec, method)
-            print(f"| {spec} | {method} | {r['wall']:.1f} | {r['cpu']:.1f} | {r['rss']:.0f} | {r['cost']} | "
+            print(f"| {os.path.basename(spec)} | {r['size']}, {r['free']} | {method} | {r['wall']:.1f} | {r['cpu']:.1f} "
+                  f"| {r['plan_rss']:.0f} / {r['rss']:.0f} | {r['cost']} | "
                   f"{'yes' if r['left'] == 0 else 'no: ' + str(r['left']) + ' left'} |", flush=True)
     load = os.getloadavg()
     print(f"\nload {load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f} (1 / 5 / 15 min) at the end; "
@@ -170,12 +184,16 @@ def main() -> None:
     parser.add_argument("--speed", action="store_true", help="issue 25's speed ratios only")
     parser.add_argument("--large", action="store_true", help="with --speed: also a 384 x 384 map (minutes)")
     parser.add_argument("--small", action="store_true", help="with --speed: the ratio table only")
+    parser.add_argument("--map", action="append", default=[], metavar="FILE.yaml",
+                        help="with --speed: also a ROS map_server map (its YAML; e.g. a 384 x 384 building map kept "
+                             "outside the repository), in the wall-time and memory table")
     parser.add_argument("--child", nargs=2, metavar=("MAP", "METHOD"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         return child(*args.child)
     if args.speed:
         large = () if args.small else ("scattered:256:0", "malaga_building") + (("scattered:384:0",) if args.large else ())
+        large += tuple(os.path.abspath(m) for m in args.map)
         return speed(large=large)
     began = time.perf_counter()
     sweep_tables()
