@@ -119,8 +119,9 @@ OPTIONS = (
            f"some of {', '.join(STRIPES_ADDITIONS)} (docs/papers/cheng2019.md)", metavar="NAMES"),
     Option("memo", check_bool, "memoise region searches by their content (False gives the same plan, slower)",
            default=True, flag="", study=False),
-    Option("time_limit", check_time_limit, "seconds; past them the remaining regions take their greedy walk "
-           "(greedy-fallback) or fail (reported)", type=float, metavar="S", default_text="none"),
+    Option("time_limit", check_time_limit, "seconds; near them the remaining regions take their greedy walk "
+           "(greedy-fallback) or fail, and at them the DAG's search and the mop-up stop, leaving a partial plan "
+           "(info.time_limit_cut says what was cut)", type=float, metavar="S", default_text="none"),
 )
 
 _PAPER = "Cheng et al. 2019"

@@ -307,12 +307,14 @@ class _Dag:
     same heap of (distance, insertion count, node), the same relaxation order and first-found
     predecessor), so the path it picks among equal ones is networkx's."""
 
-    __slots__ = ("adj", "edge_count", "stopped")
+    __slots__ = ("adj", "edge_count", "stopped", "expand", "built")
 
     def __init__(self) -> None:
         self.adj: dict = {}
         self.edge_count = 0
         self.stopped = False  # the last shortest_path was stopped (``stop``) before reaching its target
+        self.expand = None  # expand(self, s): add sweep s's part, called when an entry port ("in", s, v) is settled
+        self.built: set = set()
 
     def _successors(self, u, v) -> dict:
         """``u``'s successors, both nodes added first if new (in insertion order, as networkx)."""
@@ -373,6 +375,8 @@ class _Dag:
             dist[v] = d
             if v == target:
                 break
+            if self.expand is not None and type(v) is tuple and v[0] == "in" and v[1] not in self.built:
+                self.expand(self, v[1])
             settled += 1
             if stop is not None and settled % 32 == 0 and stop():
                 self.stopped = True
@@ -958,11 +962,14 @@ class _Planner:
         first sweep at no cost when None); per sweep s its entry ports ``("in", s, v)``, the ports at
         the cuts of each of its chains ``(s, layout, b, v)`` and its exit ports ``("out", s, v)``
         (v = −1: a free end); then "G" (the goal vertex, or a free end when None). A sweep's chains
-        (its cut grids and, with ``ends="both"``, both directions) run in parallel between its ports."""
+        (its cut grids and, with ``ends="both"``, both directions) run in parallel between its ports.
+
+        Built sweep by sweep as the search gets there (:meth:`_build_sweep`, when it first settles one of
+        the sweep's entry ports): each node's edges are added in the order a whole build adds them, so the
+        search is the same, and a search stopped by the deadline has not built the sweeps it did not reach
+        (on malaga_building the whole DAG, 162,000 region edges and a leg search per sweep, took 2 s)."""
         g = _Dag()
         self._chain = chain
-        blocks_seen: dict = {}  # this DAG's blocks -> their edges if the time limit prices them (_past_cutoff)
-        last = len(chain) - 1
         first = chain[0]
         start_inside = start is not None and start in set(first.nodes.tolist())
         if start is None:
@@ -972,48 +979,72 @@ class _Planner:
             g.add_edge("S", ("in", 0, start), kind="fixed", cost=0, path=[start])
         else:
             self._legs(g, [start], self._end_ports(first, -1), lambda v: "S", lambda v: ("in", 0, v))
-        for s, sweep in enumerate(chain):
-            goal_inside = s == last and goal is not None and goal in set(sweep.nodes.tolist())
-            if s < last:
-                nxt = chain[s + 1]
-                self._legs(g, self._end_ports(sweep, 1), self._end_ports(nxt, -1), lambda v: ("out", s, v),
-                           lambda v: ("in", s + 1, v), sweep, nxt)
-            elif goal is None:
-                g.add_edge(("out", s, -1), "G", kind="fixed", cost=0, path=[])
-            elif goal_inside:
-                g.add_edge(("out", s, goal), "G", kind="fixed", cost=0, path=[goal])
-            else:
-                self._legs(g, self._end_ports(sweep, 1), [goal], lambda v: ("out", s, v), lambda v: "G")
+        g.adj.setdefault("G", {})
+        self._dag_ends = (start, start_inside, goal)
+        g.expand, g.built = self._build_sweep, set()
+        # the time limit's estimate (_past_cutoff): the region edges of every sweep's first chain, before any is
+        # built (its end levels counted as its nearest cut's ports)
+        blocks_seen: dict = {}
+        for sweep in chain:
             for layout, (blocks, cuts, _) in sweep.layouts.items():
-                d = layout[0]
-                if s == 0 and start_inside:
-                    entries = [start]
-                else:
-                    entries = [v for v in self._ports(sweep, -d) if g.has_node(("in", s, v))]
-                if s == last and goal is None:
-                    exits = [-1]
-                elif goal_inside:
-                    exits = [goal]
-                else:
-                    exits = [v for v in self._ports(sweep, self._exit_side(layout)) if g.has_node(("out", s, v))]
-                levels = [entries] + [c.tolist() for c in cuts] + [exits]
-                end = len(levels) - 1
-
-                def name(i: int, v: int, s=s, layout=layout, end=end):
-                    return ("out", s, v) if i == end else (s, layout, i, v)
-
-                for p in entries:  # each chain its own first node: one-region chains would share an edge
-                    g.add_edge(("in", s, p), name(0, p), kind="fixed", cost=0, path=[p])
-                for b in range(len(blocks)):
-                    blocks_seen[(sweep.key, layout, b)] = len(levels[b]) * len(levels[b + 1]) * (
-                        layout == next(iter(sweep.layouts)))
-                    for p in levels[b]:
-                        for q in levels[b + 1]:
-                            g.add_region(name(b, p), name(b + 1, q), _RegionEdge((sweep, layout, b, levels[b + 1])))
+                sizes = [len(c) for c in cuts] or [2]
+                sizes = [sizes[0]] + sizes + [sizes[-1]]
+                for k in range(len(blocks)):
+                    blocks_seen[(sweep.key, layout, k)] = sizes[k] * sizes[k + 1] * (layout == next(iter(sweep.layouts)))
         self._blocks = blocks_seen
         left = [n for block, n in blocks_seen.items() if block not in self._built]
         self._unbuilt, self._unpriced = len(left), sum(left)
         return g
+
+    def _build_sweep(self, g: _Dag, s: int) -> None:
+        """Sweep s's part of the DAG: the legs from its exit ports (to the next sweep's entry ports, or to
+        "G"), then per chain the edges from its entry ports and its region edges, block by block."""
+        if s in g.built:
+            return
+        g.built.add(s)
+        chain, (start, start_inside, goal) = self._chain, self._dag_ends
+        last = len(chain) - 1
+        sweep = chain[s]
+        goal_inside = s == last and goal is not None and goal in set(sweep.nodes.tolist())
+        if s < last:
+            nxt = chain[s + 1]
+            self._legs(g, self._end_ports(sweep, 1), self._end_ports(nxt, -1), lambda v: ("out", s, v),
+                       lambda v: ("in", s + 1, v), sweep, nxt)
+        elif goal is None:
+            g.add_edge(("out", s, -1), "G", kind="fixed", cost=0, path=[])
+        elif goal_inside:
+            g.add_edge(("out", s, goal), "G", kind="fixed", cost=0, path=[goal])
+        else:
+            self._legs(g, self._end_ports(sweep, 1), [goal], lambda v: ("out", s, v), lambda v: "G")
+        for layout, (blocks, cuts, _) in sweep.layouts.items():
+            d = layout[0]
+            if s == 0 and start_inside:
+                entries = [start]
+            else:
+                entries = [v for v in self._ports(sweep, -d) if g.has_node(("in", s, v))]
+            if s == last and goal is None:
+                exits = [-1]
+            elif goal_inside:
+                exits = [goal]
+            else:
+                exits = [v for v in self._ports(sweep, self._exit_side(layout)) if g.has_node(("out", s, v))]
+            levels = [entries] + [c.tolist() for c in cuts] + [exits]
+            end = len(levels) - 1
+
+            def name(i: int, v: int, s=s, layout=layout, end=end):
+                return ("out", s, v) if i == end else (s, layout, i, v)
+
+            for p in entries:  # each chain its own first node: one-region chains would share an edge
+                g.add_edge(("in", s, p), name(0, p), kind="fixed", cost=0, path=[p])
+            for b in range(len(blocks)):
+                for p in levels[b]:
+                    for q in levels[b + 1]:
+                        g.add_region(name(b, p), name(b + 1, q), _RegionEdge((sweep, layout, b, levels[b + 1])))
+
+    def build_all(self, g: _Dag) -> None:
+        """Every sweep's part of the DAG (its size for the report, and the tests' whole DAG)."""
+        for s in range(len(self._chain)):
+            self._build_sweep(g, s)
 
     def _solve(self, g: _Dag):
         """(cost, node path) of the DAG's shortest S → G path, region costs computed lazily; (None, None)
@@ -1134,8 +1165,10 @@ class _Planner:
             return self._outcome([self.start], None, 0, info)
         info["order_tries"] = self._improve_order()
         g = self.dag(self.sweeps, start=self.start, goal=self.goal)
-        info.update({"dag_nodes": g.number_of_nodes(), "dag_edges": g.number_of_edges()})
         dag_cost, dag_path = self._solve(g)
+        if not g.stopped:  # the whole DAG's size (a search stopped by the deadline: the part it built)
+            self.build_all(g)
+        info.update({"dag_nodes": g.number_of_nodes(), "dag_edges": g.number_of_edges()})
         if dag_path is None:
             info["dag"] = f"no path: {then}"
             return self._outcome([self.start], None, 0, info)
