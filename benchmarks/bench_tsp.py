@@ -23,11 +23,17 @@
    free maps of 4096–16 384 waypoints tiled and sequenced, time and peak memory (``memory``).
 
 Run:  python benchmarks/bench_tsp.py [--quick] [--seeds N] [--budget S]
-      [--parts agreement,ga,scale,backends,tsplib,tsplib-ga,obstacles,memory,versus]
+      [--parts agreement,ga,scale,backends,tsplib,tsplib-ga,obstacles,memory,versus,implicit]
       [--tsplib-dir DIR] [--names a,b] [--methods auto,fast-tsp]
+      [--implicit-n N] [--implicit-file F.tsp] [--variants "ils:neighbours=10|…"] [--no-lkh]
 
 7. Versus (issue 25, item 4): auto against fast-tsp at ``--budget`` seconds on TSPLIB instances of 400-2103
    cities (pcb442, pr1002 and those of VERSUS_OPTIMA found in ``--tsplib-dir``), gap to the optimum.
+8. Implicit (issue 25, item 4): a seeded 16 384-city EUC_2D instance (uniform in [0, 10⁴)², written as a
+   TSPLIB file to a temporary folder, or ``--implicit-file``), loaded by ``load_tsplib`` and sequenced by
+   ``auto`` with ``time_limit=60`` in a fresh process (load time, peak RSS, cost), against LKH-3 (elkai, one
+   run) given the same file's coordinates in its own process (its time, peak RSS). ``--variants`` adds
+   ``ils`` runs with other options (``"ils:neighbours=10|ils:lk_depth=2"``), each in its own process.
 """
 
 from __future__ import annotations
@@ -426,6 +432,106 @@ def memory(quick: bool) -> None:
     print()
 
 
+def _write_uniform_tsplib(path: Path, n: int, seed: int) -> None:
+    """A TSPLIB EUC_2D file of ``n`` cities uniform in [0, 10⁴)², six decimals (read back exactly by both)."""
+    xy = np.random.default_rng(seed).uniform(0.0, 1e4, size=(n, 2))
+    lines = [f"NAME : rand{n}", f"COMMENT : uniform in [0, 1e4)^2, seed {seed}", "TYPE : TSP", f"DIMENSION : {n}",
+             "EDGE_WEIGHT_TYPE : EUC_2D", "NODE_COORD_SECTION"]
+    lines += [f"{i} {x:.6f} {y:.6f}" for i, (x, y) in enumerate(xy, 1)]
+    path.write_text("\n".join(lines + ["EOF", ""]))
+
+
+def _euc2d_tour(coords: np.ndarray, order) -> float:
+    """A closed tour's EUC_2D length by a loop of our own: nint(√(Δx² + Δy²)) = ⌊d + 0.5⌋ per leg."""
+    o = np.asarray(order, dtype=np.int64)
+    d = coords[o] - coords[np.roll(o, -1)]
+    return float(np.floor(np.sqrt((d * d).sum(1)) + 0.5).sum())
+
+
+def _implicit_run(path: str, method: str, options: dict) -> dict:
+    """In a fresh process: load the TSPLIB file, pose its implicit instance, sequence it; times, peak RSS."""
+    import resource
+
+    began = time.perf_counter()
+    tsp = load_tsplib(path)
+    loaded = time.perf_counter()
+    inst = SequencingInstance.from_tsplib(tsp, start=0)
+    posed = time.perf_counter()
+    r = sequence_waypoints(inst, method=method, seed=0, **options)
+    done = time.perf_counter()
+    assert sorted(r.order.tolist()) == list(range(inst.n)) and _euc2d_tour(tsp.coords, r.order) == r.cost
+    return {"n": inst.n, "implicit": inst.implicit, "method": r.method, "cost": r.cost, "load_s": loaded - began,
+            "pose_s": posed - loaded, "sequence_s": done - posed, "kicks": r.info.get("kicks"),
+            "timed_out": r.info.get("timed_out"), "initial": r.info.get("initial_cost"),
+            "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
+
+
+def _lkh_coordinates_run(path: str) -> dict:
+    """In a fresh process: LKH-3 (elkai's solver, RUNS = 1) on the file's coordinates as TSPLIB text, so that
+    LKH computes EUC_2D itself (no matrix: elkai's DistanceMatrix would hand it n² numbers as text)."""
+    import resource
+
+    from elkai import _elkai
+
+    tsp = load_tsplib(path)
+    text = Path(path).read_text().replace("EOF", "")
+    began = time.perf_counter()
+    tour = [int(v) - 1 for v in _elkai.solve_problem("RUNS = 1\nPROBLEM_FILE = :stdin:\n", text)][:tsp.dimension]
+    done = time.perf_counter()
+    assert sorted(tour) == list(range(tsp.dimension))
+    return {"cost": _euc2d_tour(tsp.coords, tour), "seconds": done - began,
+            "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
+
+
+def implicit(n: int, file: Path | None, variants: list[str], lkh: bool, time_limit: float = 60.0) -> None:
+    """Issue 25, item 4: a TSPLIB coordinate instance of ``n`` cities kept implicit, auto at 60 s against LKH."""
+    import os
+    import subprocess
+    import sys
+    import tempfile
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+
+    def fresh(function, *args):
+        with ProcessPoolExecutor(1, mp_context=get_context("spawn")) as pool:
+            return pool.submit(function, *args).result()
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = file or Path(folder) / f"rand{n}.tsp"
+        if file is None:
+            _write_uniform_tsplib(path, n, seed=0)
+        print(f"## Implicit TSPLIB coordinates: {path.name}, closed tour, seed 0\n")
+        load = subprocess.run([sys.executable, "-c", "import resource, sys; from htetro_opt.scenarios.tsplib import "
+                               "load_tsplib; t = load_tsplib(sys.argv[1]); print(t.dimension, resource.getrusage("
+                               "resource.RUSAGE_SELF).ru_maxrss // 1024)", str(path)], capture_output=True, text=True,
+                              check=True, env={**os.environ})
+        print(f"load_tsplib alone, fresh process: {load.stdout.strip().split()[0]} cities, peak RSS "
+              f"{load.stdout.strip().split()[1]} MB (interpreter and imports included)\n")
+        print("| run | method | costs | load s | pose s | sequence s | kicks | timed out | start cost | cost | "
+              "peak RSS MB |")
+        print("|---|---|---|---:|---:|---:|---:|---|---:|---:|---:|")
+        rows = [("auto", "auto", {"time_limit": time_limit})]
+        for variant in variants:
+            method, _, text = variant.partition(":")
+            options = {k: int(v) for k, v in (item.split("=") for item in text.split(",") if item)}
+            rows.append((variant, method, {"time_limit": time_limit, **options}))
+        results = {}
+        for label, method, options in rows:
+            row = fresh(_implicit_run, str(path), method, options)
+            results[label] = row
+            print(f"| {label}, time_limit={time_limit:g} | {row['method']} | "
+                  f"{'implicit' if row['implicit'] else 'matrix'} | {row['load_s']:.2f} | {row['pose_s']:.3f} | "
+                  f"{row['sequence_s']:.1f} | {row['kicks']} | {row['timed_out']} | {row['initial']:.0f} | "
+                  f"{row['cost']:.0f} | {row['peak_mb']:.0f} |", flush=True)
+        print()
+        if lkh and _installed("elkai"):
+            ref = fresh(_lkh_coordinates_run, str(path))
+            print(f"LKH-3 (elkai, RUNS = 1, EUC_2D coordinates): cost {ref['cost']:.0f} in {ref['seconds']:.1f} s, "
+                  f"peak RSS {ref['peak_mb']:.0f} MB\n")
+            print("Gap to LKH in %: " + ", ".join(f"{label} {100 * (r['cost'] / ref['cost'] - 1):.2f}"
+                                                for label, r in results.items()) + "\n")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true")
@@ -437,10 +543,15 @@ def main() -> None:
     parser.add_argument("--names", default="", help="versus: only these instances (comma-separated)")
     parser.add_argument("--methods", default="auto,fast-tsp",
                         help="versus: the columns, among auto, fast-tsp and ils-kicks=K")
+    parser.add_argument("--implicit-n", type=int, default=16384, help="implicit: cities of the generated instance")
+    parser.add_argument("--implicit-file", type=Path, default=None,
+                        help="implicit: a TSPLIB EUC_2D file (e.g. a public instance in /tmp) instead of the generated one")
+    parser.add_argument("--variants", default="", help="implicit: more runs, '|'-separated, e.g. ils:neighbours=10")
+    parser.add_argument("--no-lkh", action="store_true", help="implicit: skip the LKH reference")
     args = parser.parse_args()
     print(f"# Le et al. 2018 benchmark ({platform.python_version()}, {platform.processor() or platform.machine()})\n")
     parts = args.parts.split(",")
-    known = {"agreement", "ga", "scale", "backends", "memory", "tsplib", "tsplib-ga", "obstacles", "versus"}
+    known = {"agreement", "ga", "scale", "backends", "memory", "tsplib", "tsplib-ga", "obstacles", "versus", "implicit"}
     if set(parts) - known:  # "tiling" moved to bench_tiling.py: say so rather than run nothing
         parser.error(f"unknown parts: {', '.join(sorted(set(parts) - known))} (tiling: benchmarks/bench_tiling.py)")
     if "agreement" in parts:
@@ -459,6 +570,8 @@ def main() -> None:
         tsplib_ga(args.budget)
     if "obstacles" in parts:
         obstacles(30.0)
+    if "implicit" in parts:
+        implicit(args.implicit_n, args.implicit_file, [v for v in args.variants.split("|") if v], not args.no_lkh)
     if "versus" in parts:
         versus(args.budget, args.tsplib_dir, [n for n in args.names.split(",") if n], args.methods.split(","))
 

@@ -11,6 +11,8 @@
   default, or free), that minimises the summed cost. The path is open: it does not return.
 
 :class:`SequencingInstance` holds one instance for every sequencing method (cost matrix, block cells, start);
+a TSPLIB coordinate instance (:meth:`SequencingInstance.from_tsplib`) holds its coordinates and metric instead
+of a matrix, at any size;
 :class:`SequencingProblem` poses it as a pymoo permutation problem.
 
 Beyond the paper (a choice of ours, for inputs users have): an instance may come from any square
@@ -33,6 +35,7 @@ from htetro_opt._validation import check_bool, check_int
 from htetro_opt.errors import ConfigurationError, ParameterError, PlanningError
 from htetro_opt.model.tiles import scan_key, tile_poses
 from htetro_opt.scenarios.tileset import Tileset, check_tileset
+from htetro_opt.scenarios.tsplib import IMPLICIT_TYPES, TsplibInstance, tsplib_distances, tsplib_legs
 
 __all__ = [
     "DEFAULT_BLOCK_WEIGHTS",
@@ -301,11 +304,20 @@ class SequencingInstance:
     weights : sequence of 4 float, or None
         The eq.-2 weights of an implicit instance (None: :data:`DEFAULT_BLOCK_WEIGHTS`); ignored
         when ``cost`` is given.
+    coords : ndarray of float, shape (n, 2), or None
+        With ``cost`` None and no ``blocks``: the node coordinates of a TSPLIB coordinate instance, as
+        the file gives them, priced by ``metric`` when needed (an implicit instance whose matrix the
+        methods that need one build on demand, within the memory budget:
+        :func:`~htetro_opt.solvers.sequencing.sequence_waypoints`).
+    metric : str or None
+        The TSPLIB ``EDGE_WEIGHT_TYPE`` of ``coords``, one of
+        :data:`~htetro_opt.scenarios.tsplib.IMPLICIT_TYPES` (TSPLIB's integer rounding of each).
 
     Raises
     ------
     PlanningError
-        If the cost matrix is not square, non-empty and finite, or an implicit instance has no blocks.
+        If the cost matrix is not square, non-empty and finite, or an implicit instance has neither
+        blocks nor coordinates.
     ParameterError
         If ``start`` or ``end`` is not None or a waypoint index, ``end`` is given for a closed tour or
         equals ``start`` on an open path of more than one waypoint, or an argument has the wrong type
@@ -320,12 +332,22 @@ class SequencingInstance:
     closed: bool = False
     end: int | None = None
     weights: tuple[float, ...] | None = None
+    coords: np.ndarray | None = None
+    metric: str | None = None
 
     def __post_init__(self) -> None:
         weights = None
-        if self.cost is None:  # implicit eq.-2 costs
+        coords, metric = _check_coordinates(self.coords, self.metric) if self.cost is None else (None, None)
+        if coords is not None:  # implicit TSPLIB costs
+            if self.blocks is not None:
+                raise ParameterError("an instance is priced by its blocks (eq. 2) or by its coordinates, not both: "
+                                     "give blocks=None with coords")
+            cost = None
+            n = len(coords)
+        elif self.cost is None:  # implicit eq.-2 costs
             if self.blocks is None or len(_block_cells(self.blocks)) == 0:
-                raise PlanningError("an instance without a cost matrix needs the block cells of its waypoints")
+                raise PlanningError("an instance without a cost matrix needs the block cells of its waypoints "
+                                    "(or the coordinates and metric of a TSPLIB instance)")
             weights = tuple(check_weights(DEFAULT_BLOCK_WEIGHTS if self.weights is None else self.weights).tolist())
             cost = None
             n = len(_block_cells(self.blocks))
@@ -373,6 +395,8 @@ class SequencingInstance:
         object.__setattr__(self, "shape", shape)
         object.__setattr__(self, "closed", closed)
         object.__setattr__(self, "end", end)
+        object.__setattr__(self, "coords", coords)
+        object.__setattr__(self, "metric", metric)
 
     @classmethod
     def from_tileset(cls, tileset: Tileset, *, start: int | None = 1,
@@ -456,24 +480,114 @@ class SequencingInstance:
         m = check_matrix(matrix)
         return cls(m, None, start, () if ids is None else ids, (0, 0), closed, end)
 
+    @classmethod
+    def from_coordinates(cls, coords, metric: str, *, closed: bool = False, start: int | None = None,
+                         end: int | None = None, ids=None) -> "SequencingInstance":
+        """The instance of node coordinates under a TSPLIB metric, its costs implicit: memory linear in n.
+
+        Parameters
+        ----------
+        coords : array_like, shape (n, 2)
+            Finite coordinates, as a TSPLIB file gives them (``DDD.MM`` latitude and longitude for ``GEO``).
+        metric : str
+            One of :data:`~htetro_opt.scenarios.tsplib.IMPLICIT_TYPES`: ``EUC_2D`` (``nint`` of the
+            Euclidean distance), ``CEIL_2D``, ``ATT`` (pseudo-Euclidean) or ``GEO`` (TSPLIB's sphere of
+            6378.388 km), with TSPLIB's integer rounding (:mod:`htetro_opt.scenarios.tsplib`).
+        closed, start, end, ids : keyword-only
+            As :meth:`from_matrix`.
+
+        Raises
+        ------
+        ParameterError
+            On an unknown metric, coordinates that are not an (n, 2) array of finite numbers, or a bad
+            ``start`` or ``end``.
+
+        Examples
+        --------
+        >>> inst = SequencingInstance.from_coordinates([[0, 0], [3, 4], [3, 0]], "EUC_2D", closed=True)
+        >>> inst.implicit, inst.cost is None, inst.path_cost([0, 1, 2])   # 5 + 4 + 3
+        (True, True, 12.0)
+        """
+        if coords is None or metric is None:
+            raise ParameterError("from_coordinates needs the coordinates and their metric")
+        return cls(None, None, start, () if ids is None else ids, (0, 0), closed, end, coords=coords, metric=metric)
+
+    @classmethod
+    def from_tsplib(cls, tsp: TsplibInstance, *, closed: bool = True, start: int | None = None,
+                    end: int | None = None) -> "SequencingInstance":
+        """The instance of a TSPLIB file (:func:`~htetro_opt.scenarios.tsplib.load_tsplib`): its coordinates
+        and metric for the types of :data:`~htetro_opt.scenarios.tsplib.IMPLICIT_TYPES` (no n × n matrix,
+        at any size), its cost matrix otherwise (``EXPLICIT``, the 3-D, Manhattan and maximum types).
+
+        ``start`` / ``end`` are node indices (0…n−1) or None; a TSPLIB instance is a closed tour unless
+        ``closed=False``.
+
+        Raises
+        ------
+        ParameterError
+            If ``tsp`` is not a :class:`~htetro_opt.scenarios.tsplib.TsplibInstance`, or on a bad
+            ``start`` or ``end``.
+
+        Examples
+        --------
+        >>> from htetro_opt.scenarios.tsplib import parse_tsplib
+        >>> tsp = parse_tsplib("TYPE: TSP\\nDIMENSION: 3\\nEDGE_WEIGHT_TYPE: ATT\\nNODE_COORD_SECTION\\n"
+        ...                    "1 0 0\\n2 3 4\\n3 1 1\\nEOF")
+        >>> inst = SequencingInstance.from_tsplib(tsp)
+        >>> inst.implicit, inst.metric, inst.path_cost([0, 1, 2])   # 2 + 2 + 1
+        (True, 'ATT', 5.0)
+        """
+        if not isinstance(tsp, TsplibInstance):
+            raise ParameterError(f"from_tsplib needs a TsplibInstance (load_tsplib(path)), got {type(tsp).__name__}")
+        if tsp.coords is not None and tsp.edge_weight_type in IMPLICIT_TYPES:
+            return cls.from_coordinates(tsp.coords, tsp.edge_weight_type, closed=closed, start=start, end=end)
+        return cls.from_matrix(tsp.cost, closed=closed, start=start, end=end)
+
     @property
     def n(self) -> int:
-        return len(self.blocks) if self.cost is None else len(self.cost)
+        if self.cost is not None:
+            return len(self.cost)
+        return len(self.blocks) if self.coords is None else len(self.coords)
 
     @property
     def implicit(self) -> bool:
-        """Whether the costs are eq. 2 of the blocks, computed when needed, with no n × n matrix."""
+        """Whether the costs are computed when needed (eq. 2 of the blocks, or a TSPLIB metric of the
+        coordinates), with no n × n matrix."""
         return self.cost is None
+
+    @property
+    def matrix_bytes(self) -> int:
+        """Bytes of the n × n float matrix of the costs: 8·n²."""
+        return 8 * self.n * self.n
+
+    def with_matrix(self) -> "SequencingInstance":
+        """This instance with its n × n cost matrix (itself if it has one): for the methods that need a
+        matrix. An implicit instance's matrix takes :attr:`matrix_bytes`; its callers check the memory
+        budget first (:func:`~htetro_opt.solvers.sequencing.sequence_waypoints`).
+
+        Examples
+        --------
+        >>> inst = SequencingInstance.from_coordinates([[0, 0], [3, 4], [3, 0]], "EUC_2D")
+        >>> inst.with_matrix().cost.tolist()
+        [[0.0, 5.0, 3.0], [5.0, 0.0, 4.0], [3.0, 4.0, 0.0]]
+        """
+        if self.cost is not None:
+            return self
+        if self.coords is not None:
+            matrix = tsplib_distances(self.coords, self.metric)
+        else:
+            matrix = cost_matrix(self.blocks, self.weights)
+        return SequencingInstance(matrix, self.blocks, self.start, self.ids, self.shape, self.closed, self.end)
 
     @cached_property
     def symmetric(self) -> bool:
         """Whether ``cost`` is symmetric (to 1e-9 relative): the methods that assume it check this."""
         if self.cost is None:
-            return True  # eq. 2 is
+            return True  # eq. 2 and the TSPLIB metrics are
         return bool(np.allclose(self.cost, self.cost.T, rtol=1e-9, atol=1e-12))
 
     def legs(self, a, b) -> np.ndarray:
-        """The costs of the moves ``a[k] → b[k]`` (waypoint indices), from the matrix or from eq. 2.
+        """The costs of the moves ``a[k] → b[k]`` (waypoint indices), from the matrix, eq. 2 or the metric.
 
         Examples
         --------
@@ -482,6 +596,8 @@ class SequencingInstance:
         [1.0, 9.0]
         """
         a, b = np.asarray(a, dtype=np.int64), np.asarray(b, dtype=np.int64)
+        if self.coords is not None:
+            return tsplib_legs(self.coords, self.metric, a, b)
         if self.cost is None:
             return eq2_legs(self.blocks, self.weights, a, b)
         return self.cost[a, b]
@@ -580,9 +696,10 @@ def reduce_to_open_path(instance: SequencingInstance) -> OpenPathReduction:
     """
     instance = check_instance(instance)
     if instance.implicit:
-        raise ParameterError(f"this instance of {instance.n} waypoints keeps its eq.-2 costs implicit (no n × n "
+        raise ParameterError(f"this instance of {instance.n} waypoints keeps its costs implicit (no n × n "
                              "matrix), which the open-path reduction needs: build it with "
-                             "SequencingInstance.from_tileset(..., dense=True), or use method 'ils' (or auto)")
+                             "SequencingInstance.from_tileset(..., dense=True) or instance.with_matrix(), or use "
+                             "method 'ils' (or auto)")
     n, C, blocks = instance.n, instance.cost, instance.blocks
     start, end, ids = instance.start, instance.end, instance.ids
     copied = instance.closed and n > 1
@@ -621,6 +738,23 @@ def reduce_to_open_path(instance: SequencingInstance) -> OpenPathReduction:
         return order.copy()
 
     return OpenPathReduction(reduced, decode, offset)
+
+
+def _check_coordinates(coords, metric) -> tuple[np.ndarray | None, str | None]:
+    """(coords as a read-only (n, 2) float array, metric) of a coordinate instance; (None, None) without."""
+    if coords is None and metric is None:
+        return None, None
+    if metric is None or str(metric).upper() not in IMPLICIT_TYPES:
+        raise ParameterError(f"metric must be one of {', '.join(IMPLICIT_TYPES)} with coords, got {metric!r}")
+    try:
+        x = np.array(coords, dtype=float)
+    except (TypeError, ValueError) as err:
+        raise ParameterError(f"coords must be an (n, 2) array of numbers, got {type(coords).__name__} "
+                             f"{reprlib.repr(coords)}") from err
+    if x.ndim != 2 or x.shape[1] != 2 or len(x) == 0 or not np.isfinite(x).all():
+        raise ParameterError(f"coords must be a non-empty (n, 2) array of finite numbers, got shape {x.shape}")
+    x.setflags(write=False)
+    return x, str(metric).upper()
 
 
 def check_instance(instance, name: str = "instance") -> SequencingInstance:

@@ -1,5 +1,7 @@
-"""TSPLIB ``.tsp`` files (Reinelt 1991, "TSPLIB — a traveling salesman problem library"): the cost
-matrix of a symmetric (TSP) or asymmetric (ATSP) instance, under TSPLIB's own rounding.
+"""TSPLIB ``.tsp`` files (Reinelt 1991, "TSPLIB — a traveling salesman problem library"): the costs of a
+symmetric (TSP) or asymmetric (ATSP) instance, under TSPLIB's own rounding: its coordinates and their
+metric, or its explicit matrix. A coordinate instance's matrix (:attr:`TsplibInstance.cost`) is built only
+when asked for; ``SequencingInstance.from_tsplib`` keeps the types of :data:`IMPLICIT_TYPES` as coordinates.
 
 Read: ``TYPE`` TSP or ATSP; ``EDGE_WEIGHT_TYPE``
 
@@ -39,6 +41,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -46,8 +49,8 @@ import numpy as np
 from htetro_opt.errors import ScenarioError
 from htetro_opt.scenarios._paths import as_path
 
-__all__ = ["TsplibInstance", "EDGE_WEIGHT_TYPES", "EDGE_WEIGHT_FORMATS", "tsplib_distances", "parse_tsplib",
-           "load_tsplib"]
+__all__ = ["TsplibInstance", "EDGE_WEIGHT_TYPES", "EDGE_WEIGHT_FORMATS", "IMPLICIT_TYPES", "tsplib_distances",
+           "tsplib_legs", "parse_tsplib", "load_tsplib"]
 
 _COORDINATE_TYPES = {"EUC_2D": 2, "CEIL_2D": 2, "MAN_2D": 2, "MAX_2D": 2, "ATT": 2, "GEO": 2,
                      "EUC_3D": 3, "MAN_3D": 3, "MAX_3D": 3}
@@ -66,24 +69,42 @@ _SECTIONS = ("NODE_COORD_SECTION", "EDGE_WEIGHT_SECTION", "DISPLAY_DATA_SECTION"
 _KEY = re.compile(r"^\s*([A-Z_]+)\s*(?::\s*(.*?))?\s*$")
 
 
+IMPLICIT_TYPES: tuple[str, ...] = ("EUC_2D", "CEIL_2D", "ATT", "GEO")
+"""The coordinate types whose :class:`~htetro_opt.problems.SequencingInstance` keeps its costs implicit
+(coordinates and the metric, no n × n matrix: ``SequencingInstance.from_tsplib``); the other types' instances
+hold :attr:`TsplibInstance.cost`."""
+
+
 @dataclass(frozen=True, eq=False)  # holds arrays: identity equality
 class TsplibInstance:
-    """A TSPLIB instance: its cost matrix under TSPLIB's rounding, and what the header said.
+    """A TSPLIB instance: its coordinates or explicit weights, and what the header said.
 
-    ``cost[i, j]`` is the cost from node ``i + 1`` to node ``j + 1`` (integers, as floats);
-    ``coords`` the node coordinates (None for ``EXPLICIT``).
+    ``coords`` holds the node coordinates as the file gives them (``DDD.MM`` for ``GEO``; None for
+    ``EXPLICIT``), ``weights`` the matrix of an ``EXPLICIT`` section (None for coordinates).
+    :attr:`cost` is the cost matrix under TSPLIB's rounding, ``cost[i, j]`` the cost from node ``i + 1``
+    to node ``j + 1`` (integers, as floats), built from the coordinates when first asked for: 8·n²
+    bytes, which a large instance need not pay (``SequencingInstance.from_tsplib``).
     """
 
     name: str
     type: str
     edge_weight_type: str
-    cost: np.ndarray
+    weights: np.ndarray | None = None
     coords: np.ndarray | None = None
     comment: str = ""
 
     @property
     def dimension(self) -> int:
-        return len(self.cost)
+        return len(self.weights) if self.coords is None else len(self.coords)
+
+    @cached_property
+    def cost(self) -> np.ndarray:
+        """The (n, n) cost matrix (read-only), computed from the coordinates at the first call."""
+        if self.weights is not None:
+            return self.weights
+        cost = tsplib_distances(self.coords, self.edge_weight_type)
+        cost.setflags(write=False)
+        return cost
 
 
 def _nint(v: np.ndarray) -> np.ndarray:
@@ -95,8 +116,70 @@ def _geo_radians(v: np.ndarray) -> np.ndarray:
     return 3.141592 * (degrees + 5.0 * (v - degrees) / 3.0) / 180.0
 
 
+def _check_coordinates(coords, edge_weight_type: str) -> tuple[str, np.ndarray]:
+    """(the type, upper case; the coordinates as an (n, k) float array), validated."""
+    kind = str(edge_weight_type).upper()
+    if kind not in _COORDINATE_TYPES:
+        raise ScenarioError(f"unknown TSPLIB EDGE_WEIGHT_TYPE {edge_weight_type!r}: expected one of "
+                            f"{', '.join(_COORDINATE_TYPES)} for coordinates")
+    try:
+        x = np.asarray(coords, dtype=float)
+    except (TypeError, ValueError) as err:
+        raise ScenarioError(f"TSPLIB coordinates must be numbers, got {coords!r}") from err
+    k = _COORDINATE_TYPES[kind]
+    if x.ndim != 2 or x.shape[1] != k:
+        raise ScenarioError(f"{kind} needs {k} coordinates per node, got shape {x.shape}")
+    return kind, x
+
+
+def _metric(xa: np.ndarray, xb: np.ndarray, kind: str) -> np.ndarray:
+    """TSPLIB's distance between the coordinate rows ``xa`` and ``xb`` (broadcast; the last axis the
+    coordinates), the same nodes included (GEO gives them 1: callers zero them)."""
+    if kind == "GEO":
+        lat_a, lon_a = _geo_radians(xa[..., 0]), _geo_radians(xa[..., 1])
+        lat_b, lon_b = _geo_radians(xb[..., 0]), _geo_radians(xb[..., 1])
+        q1 = np.cos(lon_a - lon_b)
+        q2 = np.cos(lat_a - lat_b)
+        q3 = np.cos(lat_a + lat_b)
+        arc = np.arccos(np.clip(0.5 * ((1.0 + q1) * q2 - (1.0 - q1) * q3), -1.0, 1.0))
+        return np.floor(6378.388 * arc + 1.0)
+    delta = np.abs(xa - xb)
+    if kind.startswith("MAN"):
+        return _nint(delta.sum(-1))
+    if kind.startswith("MAX"):
+        return _nint(delta).max(-1)
+    if kind == "ATT":
+        r = np.sqrt((delta ** 2).sum(-1) / 10.0)
+        t = _nint(r)
+        return np.where(t < r, t + 1.0, t)
+    if kind == "CEIL_2D":
+        return np.ceil(np.sqrt((delta ** 2).sum(-1)))
+    return _nint(np.sqrt((delta ** 2).sum(-1)))
+
+
+def tsplib_legs(coords, edge_weight_type: str, a, b) -> np.ndarray:
+    """TSPLIB's distances of the legs ``a[k] → b[k]`` (node indices 0…n−1), without a matrix.
+
+    Raises
+    ------
+    ScenarioError
+        As :func:`tsplib_distances`.
+
+    Examples
+    --------
+    >>> tsplib_legs([[0, 0], [3, 4], [1, 1]], "EUC_2D", [0, 0, 2], [1, 2, 2]).tolist()   # √2 → 1; a node to itself 0
+    [5.0, 1.0, 0.0]
+    """
+    kind, x = _check_coordinates(coords, edge_weight_type)
+    a, b = np.asarray(a, dtype=np.int64), np.asarray(b, dtype=np.int64)
+    return np.where(a == b, 0.0, _metric(x[a], x[b], kind))
+
+
 def tsplib_distances(coords, edge_weight_type: str) -> np.ndarray:
     """The (n, n) matrix of TSPLIB distances between node coordinates (module docstring).
+
+    Computed a block of rows at a time, so that its temporaries stay near 64 MB whatever n: the
+    matrix itself is 8·n² bytes.
 
     Raises
     ------
@@ -109,38 +192,12 @@ def tsplib_distances(coords, edge_weight_type: str) -> np.ndarray:
     >>> tsplib_distances([[0, 0], [3, 4], [1, 1]], "ATT").tolist()[0]   # √(25/10) = 1.58 → 2; √(2/10) → 1
     [0.0, 2.0, 1.0]
     """
-    kind = str(edge_weight_type).upper()
-    if kind not in _COORDINATE_TYPES:
-        raise ScenarioError(f"unknown TSPLIB EDGE_WEIGHT_TYPE {edge_weight_type!r}: expected one of "
-                            f"{', '.join(_COORDINATE_TYPES)} for coordinates")
-    try:
-        x = np.asarray(coords, dtype=float)
-    except (TypeError, ValueError) as err:
-        raise ScenarioError(f"TSPLIB coordinates must be numbers, got {coords!r}") from err
-    k = _COORDINATE_TYPES[kind]
-    if x.ndim != 2 or x.shape[1] != k:
-        raise ScenarioError(f"{kind} needs {k} coordinates per node, got shape {x.shape}")
-    if kind == "GEO":
-        lat, lon = _geo_radians(x[:, 0]), _geo_radians(x[:, 1])
-        q1 = np.cos(lon[:, None] - lon[None, :])
-        q2 = np.cos(lat[:, None] - lat[None, :])
-        q3 = np.cos(lat[:, None] + lat[None, :])
-        arc = np.arccos(np.clip(0.5 * ((1.0 + q1) * q2 - (1.0 - q1) * q3), -1.0, 1.0))
-        d = np.floor(6378.388 * arc + 1.0)
-    else:
-        delta = np.abs(x[:, None, :] - x[None, :, :])
-        if kind.startswith("MAN"):
-            d = _nint(delta.sum(-1))
-        elif kind.startswith("MAX"):
-            d = _nint(delta).max(-1)
-        elif kind == "ATT":
-            r = np.sqrt((delta ** 2).sum(-1) / 10.0)
-            t = _nint(r)
-            d = np.where(t < r, t + 1.0, t)
-        elif kind == "CEIL_2D":
-            d = np.ceil(np.sqrt((delta ** 2).sum(-1)))
-        else:
-            d = _nint(np.sqrt((delta ** 2).sum(-1)))
+    kind, x = _check_coordinates(coords, edge_weight_type)
+    n = len(x)
+    d = np.empty((n, n))
+    step = max(1, (1 << 20) // max(1, n))  # rows a block: about 8 MB a temporary
+    for r in range(0, n, step):
+        d[r:r + step] = _metric(x[r:r + step, None, :], x[None, :, :], kind)
     np.fill_diagonal(d, 0.0)
     return d
 
@@ -324,9 +381,10 @@ def parse_tsplib(text: str, *, where: str = "TSPLIB text") -> TsplibInstance:
         node_coords[ids.astype(np.int64) - 1] = rows[:, 1:]
         if not np.isfinite(node_coords).all():
             raise reader.error("node coordinates must be finite", first)
-        cost = tsplib_distances(node_coords, weight_type)
-    cost.setflags(write=False)
-    if node_coords is not None:
+    if weight_type == "EXPLICIT":
+        cost.setflags(write=False)
+    else:
+        cost = None  # TsplibInstance.cost computes the matrix when first asked for
         node_coords.setflags(write=False)
     return TsplibInstance(name, kind, weight_type, cost, node_coords, " ".join(comments))
 

@@ -12,6 +12,13 @@ fixed end is handed to a method that does not take it natively (all but ``fast-t
 as that problem, by :func:`~htetro_opt.problems.waypoint_sequencing.reduce_to_open_path`; its order
 is decoded and re-priced on the instance as given. A method that assumes symmetric costs, or needs
 tile geometry, refuses an instance without them before it runs.
+
+A TSPLIB coordinate instance keeps its costs implicit (coordinates and the metric, memory linear in n):
+``ils`` (and so ``auto`` beyond the exact range) prices it as it is; a method that needs the matrix gets
+it built for its run when the matrix and one working copy, ``2 · 8·n²`` bytes, fit the memory budget
+(:func:`~htetro_opt.model.simulate.memory_budget`), and is refused with a
+:class:`~htetro_opt.errors.PlanningError` naming the method, n and the memory before any work otherwise.
+An implicit eq.-2 instance (a tileset above ``DENSE_LIMIT``) is refused by those methods, as before.
 """
 
 from __future__ import annotations
@@ -97,7 +104,8 @@ def auto_method(instance: SequencingInstance) -> str:
     """The method ``method="auto"`` runs on ``instance``.
 
     ``exact`` up to :data:`EXACT_AUTO_LIMIT` waypoints (a closed tour counts its copied first
-    waypoint too). Beyond, and for an implicit instance (no cost matrix), for symmetric costs, ``ils`` (the compiled iterated local search, whose
+    waypoint too; a TSPLIB coordinate instance gets its small matrix built for it). Beyond, and for an
+    implicit eq.-2 instance (no cost matrix), for symmetric costs, ``ils`` (the compiled iterated local search, whose
     budget is counted in kicks: the same seed gives the same order on every machine; numba, which
     compiles it, is a core dependency); ``ortools`` for asymmetric costs.
 
@@ -113,7 +121,7 @@ def auto_method(instance: SequencingInstance) -> str:
     ('exact', 'ortools')
     """
     instance = check_instance(instance)
-    if instance.implicit:
+    if instance.implicit and instance.coords is None:  # eq. 2 without a matrix: only ils sequences it
         return "ils"
     size = instance.n + (1 if instance.closed and instance.n > 1 else 0)
     if size <= EXACT_AUTO_LIMIT:
@@ -129,7 +137,9 @@ def _resolve(method, instance: SequencingInstance):
     chosen = SPEC.method(method)
     run = SPEC.method(auto_method(instance)) if chosen.name == "auto" else chosen
     capabilities = run.capabilities
-    if instance.implicit and "implicit" not in capabilities:
+    if instance.implicit and instance.coords is not None and "implicit" not in capabilities:
+        _check_matrix_memory(run.name, instance)
+    elif instance.implicit and "implicit" not in capabilities:
         raise ParameterError(f"method {run.name!r} needs the cost matrix, and this instance of {instance.n} waypoints "
                              "keeps its eq.-2 costs implicit (above DENSE_LIMIT waypoints): use ils or auto, or "
                              "SequencingInstance.from_tileset(..., dense=True)")
@@ -141,6 +151,23 @@ def _resolve(method, instance: SequencingInstance):
                              f"{', '.join(_asymmetric())} (or auto)")
     label = run.name if chosen is run else f"{chosen.name} ({run.name})"
     return label, chosen, run
+
+
+# The n × n float matrix, and the one working copy every matrix method makes at least (the open-path
+# reduction's, the symmetrised one, the integer one of fast-tsp and lkh): a floor, not a measurement of each.
+_MATRIX_COPIES = 2
+
+
+def _check_matrix_memory(method: str, instance: SequencingInstance) -> None:
+    """Refuse, before any work, to build the matrix of a coordinate instance for ``method`` past the memory
+    budget (:func:`~htetro_opt.model.simulate.memory_budget`)."""
+    from htetro_opt.model.simulate import check_memory
+
+    check_memory(_MATRIX_COPIES * instance.matrix_bytes,
+                 f"method {method!r} needs the n × n cost matrix, and on this TSPLIB {instance.metric} instance of "
+                 f"{instance.n:,} nodes (costs implicit) building it and a working copy",
+                 "use method ils or auto, which keep the costs implicit at any size, or raise the budget "
+                 "(htetro_opt.model.simulate.budget_of)")
 
 
 def sequence_waypoints(instance: SequencingInstance, *, method="auto", **options) -> SequenceResult:
@@ -209,10 +236,12 @@ def sequence_waypoints(instance: SequencingInstance, *, method="auto", **options
         function, capabilities, call = run.load(SPEC.package), run.capabilities, {**run.presets, **call}
     reduction = None
     solved = instance
+    if not callable(method) and instance.implicit and instance.coords is not None and "implicit" not in capabilities:
+        solved = instance.with_matrix()  # within the budget: _resolve checked it
     if (instance.closed or instance.end is not None) and "tours" not in capabilities:
-        reduction = reduce_to_open_path(instance)
+        reduction = reduce_to_open_path(solved)
         solved = reduction.instance
-    if solved is not instance and solved.n > call.get("max_size", solved.n):  # the user's count, and why it grew
+    if reduction is not None and solved.n > call.get("max_size", solved.n):  # the user's count, and why it grew
         raise ParameterError(f"the exact method proves optima of at most {call['max_size']} waypoints, this instance "
                              f"has {instance.n} ({solved.n} as the open path a closed tour or a fixed end is solved "
                              "as): use the ils, ortools or local method for large instances")

@@ -183,10 +183,13 @@ def _or_move(tour, pos, log, count, p, s1, s2, nx, x, y, forward):
 
 
 def _d(cm, a, b):
-    """The cost of the leg (a, b). ``cm`` is a dense matrix, or the tuple ``(P, w, pen)`` of an implicit
-    instance: block cells ``P`` (m, 4, 2) and weights ``w`` of eq. 2, ``pen[j]`` the leg from the
+    """The cost of the leg (a, b). ``cm`` is a dense matrix, the tuple ``(P, w, pen)`` of an implicit
+    eq.-2 instance (block cells ``P`` (m, 4, 2) and weights ``w`` of eq. 2), or the tuple
+    ``(X, kind, pen)`` of a TSPLIB coordinate instance (:func:`_tsplib`); ``pen[j]`` the leg from the
     dummy node ``m`` to node ``j``. (Plain Python; the kernel's compiled twin is below.)"""
-    return cm[a, b] if isinstance(cm, np.ndarray) else _eq2(cm, a, b)
+    if isinstance(cm, np.ndarray):
+        return cm[a, b]
+    return _tsplib(cm, a, b) if isinstance(cm[1], (int, np.integer)) else _eq2(cm, a, b)
 
 
 def _eq2(cm, a, b):
@@ -205,12 +208,50 @@ def _eq2(cm, a, b):
     return total
 
 
+_EUC_2D, _CEIL_2D, _ATT, _GEO = range(4)
+_METRIC_CODES = {"EUC_2D": _EUC_2D, "CEIL_2D": _CEIL_2D, "ATT": _ATT, "GEO": _GEO}
+"""The ``kind`` of a TSPLIB cost model, by EDGE_WEIGHT_TYPE (htetro_opt.scenarios.tsplib.IMPLICIT_TYPES)."""
+
+
+def _tsplib(cm, a, b):
+    """TSPLIB's integer distance of the leg (a, b) of a coordinate instance, or the dummy's leg: ``X`` the
+    (m, 2) coordinates (GEO: latitude and longitude in TSPLIB's radians), ``kind`` a :data:`_METRIC_CODES`
+    value, the same formulas as :mod:`htetro_opt.scenarios.tsplib` (``nint(v) = ⌊v + 0.5⌋``)."""
+    X, kind, pen = cm
+    m = X.shape[0]
+    if a == m:
+        return pen[b]
+    if b == m:
+        return pen[a]
+    if a == b:
+        return 0.0
+    if kind == _GEO:
+        q1 = math.cos(X[a, 1] - X[b, 1])
+        q2 = math.cos(X[a, 0] - X[b, 0])
+        q3 = math.cos(X[a, 0] + X[b, 0])
+        v = min(1.0, max(-1.0, 0.5 * ((1.0 + q1) * q2 - (1.0 - q1) * q3)))
+        return math.floor(6378.388 * math.acos(v) + 1.0)
+    dx = X[a, 0] - X[b, 0]
+    dy = X[a, 1] - X[b, 1]
+    if kind == _ATT:
+        r = math.sqrt((dx * dx + dy * dy) / 10.0)
+        t = math.floor(r + 0.5)
+        return t + 1.0 if t < r else t
+    e = math.sqrt(dx * dx + dy * dy)
+    if kind == _CEIL_2D:
+        return math.ceil(e)
+    return math.floor(e + 0.5)
+
+
 # Chosen by type when the kernel compiles, so a dense matrix costs one load, as if written inline:
-# a run-time branch between the two (or a call LLVM does not inline) made the kernel 8x slower.
+# a run-time branch between the kinds (or a call LLVM does not inline) made the kernel 8x slower.
+# Within a TSPLIB model the metric is a run-time branch on ``kind``, the same for every leg of a run.
 @overload(_d, jit_options={"cache": True})
 def _d_compiled(cm, a, b):
     if isinstance(cm, numba.types.Array):
         return lambda cm, a, b: cm[a, b]
+    if isinstance(cm.types[1], numba.types.Integer):
+        return _tsplib
     return _eq2
 
 
@@ -508,6 +549,15 @@ def _tour_cost(cm, tour):
 
 
 @_jit
+def _legs(cm, a, b):
+    """The kernel's costs of the legs ``a[k] → b[k]``."""
+    out = np.empty(a.shape[0])
+    for i in range(a.shape[0]):
+        out[i] = _d(cm, a[i], b[i])
+    return out
+
+
+@_jit
 def _neighbour_costs(cm, nbr):
     """Each node's legs to its neighbours, the search's most frequent look-ups, priced once (eq. 2 has
     four square roots a leg)."""
@@ -611,25 +661,38 @@ def _cost_model(instance: SequencingInstance) -> tuple[tuple, int, int | None, f
     """The closed, symmetric tour the kernel solves (module docstring): ``(cm, m, dummy, top)``.
 
     ``cm`` for :func:`_d`: the dense matrix of ``m`` nodes (the instance's symmetrised, plus the
-    dummy), or, for an implicit instance, the block cells ``P``, weights ``w`` and the dummy's legs
-    ``pen``; ``dummy`` is the dummy's index (None: closed); ``top``
+    dummy), or, for an implicit instance, the block cells ``P`` and weights ``w`` (eq. 2) or the
+    coordinates ``X`` and the metric's code ``kind`` (TSPLIB), and the dummy's legs ``pen``; ``dummy`` is the dummy's index (None: closed); ``top``
     bounds every leg's cost.
     """
     n = instance.n
     pinned = [i for i in (instance.start, instance.end) if i is not None]
     if instance.implicit:
-        P = np.ascontiguousarray(instance.blocks, dtype=float)
-        w = np.asarray(instance.weights, dtype=float)
-        cells = P.reshape(-1, 2)
-        top = float(w.sum() * np.hypot(*(cells.max(0) - cells.min(0))))  # no two cells lie further apart
+        if instance.coords is not None:
+            kind = _METRIC_CODES[instance.metric]
+            X = np.array(instance.coords, dtype=float)
+            if kind == _GEO:  # TSPLIB's radians, once (scenarios.tsplib's rule: degrees truncated, .MM minutes)
+                degrees = np.trunc(X)
+                X = 3.141592 * (degrees + 5.0 * (X - degrees) / 3.0) / 180.0
+                top = math.floor(6378.388 * math.pi + 1.0)  # half the sphere's circumference
+            else:
+                diagonal = float(np.hypot(*(X.max(0) - X.min(0))))  # no two nodes lie further apart
+                top = math.ceil(diagonal / math.sqrt(10.0) if kind == _ATT else diagonal) + 1.0
+            model = [np.ascontiguousarray(X), np.int64(kind)]
+        else:
+            P = np.ascontiguousarray(instance.blocks, dtype=float)
+            w = np.asarray(instance.weights, dtype=float)
+            cells = P.reshape(-1, 2)
+            top = float(w.sum() * np.hypot(*(cells.max(0) - cells.min(0))))  # no two cells lie further apart
+            model = [P, w]
         if instance.closed:
-            return (P, w, np.zeros(0)), n, None, top
+            return (*model, np.zeros(0)), n, None, top
         pen = np.zeros(n)
         if pinned:
             pen[:] = 3.0 * top + 1.0
             pen[pinned] = 0.0
             top = 3.0 * top + 1.0
-        return (P, w, pen), n + 1, n, top
+        return (*model, pen), n + 1, n, top
     C = (instance.cost + instance.cost.T) / 2
     if instance.closed:
         D = np.ascontiguousarray(C)
@@ -651,15 +714,22 @@ def _cheapest(candidates: np.ndarray, costs: np.ndarray, k: int) -> np.ndarray:
 
 
 def _neighbour_lists(D: np.ndarray, k: int) -> np.ndarray:
-    """Each node's ``k`` cheapest other nodes in a dense matrix, a block of rows at a time."""
+    """Each node's ``k`` cheapest other nodes in a dense matrix, a block of rows at a time; ties at the
+    k-th cost go to the lowest indices (as :func:`_implicit_neighbour_lists` breaks them, so that an
+    instance gives the same lists with its matrix and without; argpartition's own pick among ties
+    depends on its algorithm)."""
     n = len(D)
     k = min(k, n - 1)
     out = np.empty((n, k), dtype=np.int64)
     step = max(1, (1 << 22) // n)  # rows per block: about 32 MB of temporaries
     for r in range(0, n, step):
         masked = D[r:r + step].copy()
-        masked[np.arange(len(masked)), np.arange(r, r + len(masked))] = np.inf
-        part = np.argpartition(masked, k - 1, axis=1)[:, :k] if k < n - 1 else np.argsort(masked, axis=1)[:, :k]
+        rows = np.arange(len(masked))
+        masked[rows, np.arange(r, r + len(masked))] = np.inf
+        kth = np.partition(masked, k - 1, axis=1)[:, k - 1:k]
+        tied = masked == kth
+        keep = (masked < kth) | (tied & (np.cumsum(tied, axis=1) <= k - (masked < kth).sum(1, keepdims=True)))
+        part = np.nonzero(keep)[1].reshape(len(masked), k)  # k a row, by index
         out[r:r + step] = _cheapest(part, np.take_along_axis(masked, part, axis=1), k)
     return out
 
@@ -669,21 +739,48 @@ def _centres(P: np.ndarray, w: np.ndarray) -> np.ndarray:
     return (P * w[None, :, None]).sum(1) / w.sum()
 
 
+def _is_tsplib(cm) -> bool:
+    return isinstance(cm, tuple) and isinstance(cm[1], (int, np.integer))
+
+
+def _search_points(cm: tuple) -> np.ndarray:
+    """Points whose Euclidean nearest neighbours are a leg's likely cheapest: the blocks' centres (eq. 2),
+    the coordinates (the planar TSPLIB metrics grow with their distance), or for GEO the points on the
+    unit sphere (the great-circle distance grows with their chord)."""
+    if not _is_tsplib(cm):
+        return _centres(cm[0], cm[1])
+    X, kind = cm[0], int(cm[1])
+    if kind != _GEO:
+        return X
+    lat, lon = X[:, 0], X[:, 1]
+    return np.column_stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)])
+
+
+def _plane_points(cm: tuple) -> np.ndarray:
+    """2-D points for the start tour's space-filling curve (GEO: latitude and longitude)."""
+    return cm[0] if _is_tsplib(cm) else _centres(cm[0], cm[1])
+
+
 def _implicit_neighbour_lists(cm: tuple, dummy: int | None, k: int) -> np.ndarray:
     """Neighbour lists without a matrix: each waypoint's nearest ``4k`` by the centre of its blocks (a
     k-d tree; eq. 2 is at least Σw times the centres' distance, so near centres are the likely cheap
-    legs), ranked by eq. 2; the dummy's legs (``pen``) priced as the dense lists would price them."""
+    legs), or by its TSPLIB coordinates (:func:`_search_points`), ranked by the costs themselves (ties by
+    index); the dummy's legs (``pen``) priced as the dense lists would price them."""
     from scipy.spatial import cKDTree
 
-    P, w, pen = cm
-    n = len(P)
+    pen = cm[2]
+    n = len(cm[0])
     m = n + (dummy is not None)
     k = min(k, m - 1)
     q = min(n, 4 * k + 1)
-    _, near = cKDTree(_centres(P, w)).query(_centres(P, w), k=q)
+    points = _search_points(cm)
+    _, near = cKDTree(points).query(points, k=q)
     near = np.asarray(near, dtype=np.int64).reshape(n, q)
     rows = np.repeat(np.arange(n), q)
-    costs = eq2_legs(P, w, rows, near.ravel()).reshape(n, q)
+    if _is_tsplib(cm):
+        costs = _legs(cm, rows, near.ravel()).reshape(n, q)
+    else:
+        costs = eq2_legs(cm[0], cm[1], rows, near.ravel()).reshape(n, q)
     costs[near == np.arange(n)[:, None]] = np.inf
     if dummy is not None:
         near = np.hstack([near, np.full((n, 1), dummy)])
@@ -699,7 +796,7 @@ def _hilbert_tour(cm: tuple, dummy: int | None, first: int) -> np.ndarray:
     """A tour without a matrix: the waypoints along a Hilbert curve through their block centres, from
     ``first``, then the dummy (next to ``first`` round the cycle). Its legs are short wherever the
     waypoints are dense, which is all the local search needs from a start."""
-    xy = _centres(cm[0], cm[1])
+    xy = _plane_points(cm)
     span = np.maximum(xy.max(0) - xy.min(0), 1e-12)
     side = 1 << 16
     x, y = (((xy - xy.min(0)) / span.max()) * (side - 1)).round().astype(np.int64).T
@@ -716,6 +813,48 @@ def _hilbert_tour(cm: tuple, dummy: int | None, first: int) -> np.ndarray:
     order = np.argsort(d, kind="stable")
     order = np.roll(order, -int(np.flatnonzero(order == first)[0]))
     return order if dummy is None else np.append(order, dummy).astype(np.int64)
+
+
+def _nearest_neighbour_tour(cm: tuple, dummy: int | None, first: int) -> np.ndarray:
+    """The nearest-neighbour tour of a TSPLIB coordinate model from ``first`` without a matrix, then the
+    dummy: each step goes to the cheapest unvisited node, ties to the lowest index, the tour the dense
+    matrix's :func:`_greedy_tour` builds from the same node. A k-d tree over the unvisited nodes (rebuilt
+    when half of it is visited) gives the candidates by distance; the metric's rounding never decreases
+    with distance, so once the farthest candidate costs more than the cheapest unvisited one, no node
+    further away can be cheaper or tie."""
+    from scipy.spatial import cKDTree
+
+    points = _search_points(cm)
+    n = len(points)
+    alive = np.ones(n, dtype=bool)
+    tour = np.empty(n, dtype=np.int64)
+    tour[0] = here = first
+    alive[first] = False
+    ids = np.flatnonzero(alive)
+    tree = cKDTree(points[ids]) if n > 1 else None
+    dead = 0  # visited nodes still in the tree
+    for step in range(1, n):
+        if 2 * dead >= len(ids):
+            ids = np.flatnonzero(alive)
+            tree = cKDTree(points[ids])
+            dead = 0
+        k = 8
+        while True:
+            k = min(k, len(ids))
+            _, at = tree.query(points[here], k=k)
+            found = ids[np.atleast_1d(at)]
+            live = found[alive[found]]
+            if live.size:
+                costs = _legs(cm, np.full(live.size, here, dtype=np.int64), live)
+                cheapest = costs.min()
+                if k == len(ids) or _legs(cm, np.array([here]), found[-1:])[0] > cheapest:
+                    here = int(live[costs == cheapest].min())
+                    break
+            k *= 2
+        tour[step] = here
+        alive[here] = False
+        dead += 1
+    return tour if dummy is None else np.append(tour, dummy).astype(np.int64)
 
 
 def _decode(tour: np.ndarray, dummy: int | None, instance: SequencingInstance) -> np.ndarray:
@@ -759,6 +898,8 @@ def _greedy_tour(D: np.ndarray) -> np.ndarray:
 
 def _costs_kind(instance) -> str:
     """How the run reads its costs, for the result's ``costs`` field (docs/formats.md)."""
+    if instance.coords is not None:
+        return f"implicit ({instance.metric} on demand)"
     return "implicit (eq. 2 on demand)" if instance.implicit else "matrix"
 
 
@@ -836,7 +977,11 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
                                                 "improving_kicks": 0, "timed_out": False, "tour_cost": cost}
     if instance.implicit:
         nbr = _implicit_neighbour_lists(cm, dummy, neighbours)
-        tour = _hilbert_tour(cm, dummy, 0 if instance.start is None else instance.start)
+        first = 0 if instance.start is None else instance.start
+        if instance.coords is not None:  # (a closed tour: the dense matrix's start tour, from node 0 as it)
+            tour = _nearest_neighbour_tour(cm, dummy, 0 if dummy is None else first)
+        else:
+            tour = _hilbert_tour(cm, dummy, first)
     else:
         nbr = _neighbour_lists(cm, neighbours)
         tour = _greedy_tour(cm).astype(np.int64)

@@ -223,7 +223,7 @@ def _pose(source, *, label, start, end, closed, weights, shapes) -> Problem:
                                  "asked for an open path (--open on the command line, closed=False in a call or a "
                                  "study)")
         nodes = range(1, loaded.dimension + 1)
-        instance = SequencingInstance.from_matrix(loaded.cost, closed=closed,
+        instance = SequencingInstance.from_tsplib(loaded, closed=closed,  # coordinates stay implicit
                                                   start=_index(start, nodes, label("start"), "node"),
                                                   end=_index(end, nodes, label("end"), "node"))
         return Problem(loaded.name, (instance,), scenario=loaded, extras={"instance": instance, "tsplib": loaded})
