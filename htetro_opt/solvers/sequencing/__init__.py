@@ -22,7 +22,8 @@ function of its own:
 
 Instances may be closed tours or open paths with a fixed end, from any cost matrix
 (:meth:`~htetro_opt.problems.SequencingInstance.from_matrix`) or a TSPLIB file
-(:func:`htetro_opt.scenarios.tsplib.load_tsplib`). A tileset of more than
+(:func:`htetro_opt.scenarios.tsplib.load_tsplib`; its coordinate types keep their costs implicit at any
+size, and the methods that need a matrix get it built within the memory budget). A tileset of more than
 :data:`~htetro_opt.problems.waypoint_sequencing.DENSE_LIMIT` waypoints keeps its eq.-2 costs
 implicit (no n × n matrix, memory linear in n); ``ils`` (and so ``auto``) sequences it, the other
 methods ask for ``from_tileset(..., dense=True)``.
@@ -33,7 +34,7 @@ from htetro_opt._lazy import attach
 __getattr__, __dir__, __all__ = attach(__name__, {
     "sequence_waypoints": "._dispatch", "SequenceResult": "._dispatch", "SPEC": "._spec",
     "EXACT_AUTO_LIMIT": "._spec", "ASYMMETRIC_METHODS": "._dispatch",
-    "auto_method": "._dispatch", "default_time_limit": "._budgets", "TIME_LIMIT_TEXT": "._budgets",
+    "auto_method": "._dispatch", "MATRIX_BYTES_PER_ENTRY": "._dispatch", "MATRIX_BYTES_DEFAULT": "._dispatch", "default_time_limit": "._budgets", "TIME_LIMIT_TEXT": "._budgets",
     "solve_exact": "._exact", "held_karp": "._exact", "EXACT_MAX_SIZE": "._spec",
     "solve_ortools": "._ortools", "ortools_time_limit": "._ortools", "FIRST_SOLUTIONS": "._spec",
     "solve_local": "._local", "nearest_neighbour": "._local", "nearest_neighbour_paths": "._local",

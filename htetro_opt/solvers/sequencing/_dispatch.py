@@ -15,8 +15,8 @@ tile geometry, refuses an instance without them before it runs.
 
 A TSPLIB coordinate instance keeps its costs implicit (coordinates and the metric, memory linear in n):
 ``ils`` (and so ``auto`` beyond the exact range) prices it as it is; a method that needs the matrix gets
-it built for its run when the matrix and one working copy, ``2 · 8·n²`` bytes, fit the memory budget
-(:func:`~htetro_opt.model.simulate.memory_budget`), and is refused with a
+it built for its run when the matrix and the method's copies of it (:data:`MATRIX_BYTES_PER_ENTRY`, about
+48 bytes an entry) fit the memory budget (:func:`~htetro_opt.model.simulate.memory_budget`), and is refused with a
 :class:`~htetro_opt.errors.PlanningError` naming the method, n and the memory before any work otherwise.
 An implicit eq.-2 instance (a tileset above ``DENSE_LIMIT``) is refused by those methods, as before.
 """
@@ -43,6 +43,8 @@ from htetro_opt.solvers.sequencing._spec import EXACT_AUTO_LIMIT, SPEC
 
 __all__ = [
     "ASYMMETRIC_METHODS",
+    "MATRIX_BYTES_DEFAULT",
+    "MATRIX_BYTES_PER_ENTRY",
     "SequenceResult",
     "auto_method",
     "sequence_waypoints",
@@ -153,9 +155,15 @@ def _resolve(method, instance: SequencingInstance):
     return label, chosen, run
 
 
-# The n × n float matrix, and the one working copy every matrix method makes at least (the open-path
-# reduction's, the symmetrised one, the integer one of fast-tsp and lkh): a floor, not a measurement of each.
-_MATRIX_COPIES = 2
+MATRIX_BYTES_PER_ENTRY = {"lkh": 80}
+"""Peak bytes per entry of the n × n matrix a method needs on a coordinate instance (default
+:data:`MATRIX_BYTES_DEFAULT`): the float matrix and the method's own copies (the open-path reduction, the
+symmetrised and integer ones, elkai's lists and text). Measured on 2026-12-07 as peak RSS above the
+process's start at 1500-3000 cities: fast-tsp 44, local 50, lkh 74 (benchmarks/README.md, "Implicit TSPLIB
+coordinates at 16 384 cities")."""
+
+MATRIX_BYTES_DEFAULT = 48
+"""Peak bytes per matrix entry of the matrix methods not in :data:`MATRIX_BYTES_PER_ENTRY`."""
 
 
 def _check_matrix_memory(method: str, instance: SequencingInstance) -> None:
@@ -163,9 +171,10 @@ def _check_matrix_memory(method: str, instance: SequencingInstance) -> None:
     budget (:func:`~htetro_opt.model.simulate.memory_budget`)."""
     from htetro_opt.model.simulate import check_memory
 
-    check_memory(_MATRIX_COPIES * instance.matrix_bytes,
+    per_entry = MATRIX_BYTES_PER_ENTRY.get(method, MATRIX_BYTES_DEFAULT)
+    check_memory(per_entry * instance.n ** 2,
                  f"method {method!r} needs the n × n cost matrix, and on this TSPLIB {instance.metric} instance of "
-                 f"{instance.n:,} nodes (costs implicit) building it and a working copy",
+                 f"{instance.n:,} nodes (costs implicit) the matrix and the method's copies of it",
                  "use method ils or auto, which keep the costs implicit at any size, or raise the budget "
                  "(htetro_opt.model.simulate.budget_of)")
 

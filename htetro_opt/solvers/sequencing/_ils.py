@@ -14,14 +14,19 @@ Stützle 2003):
 - **Costs**: the dense matrix, or, for an implicit instance (no n × n matrix, above
   :data:`~htetro_opt.problems.waypoint_sequencing.DENSE_LIMIT` waypoints), eq. 2 computed from the
   block cells at each look-up, so that memory stays linear in n (benchmarks/README.md, "TSPLIB,
-  a map with obstacles, memory linear in n"). The kernel is compiled once per kind (:func:`_d`), so
-  the dense case pays nothing for the other.
+  a map with obstacles, memory linear in n"); or, for a TSPLIB coordinate instance (``EUC_2D``,
+  ``CEIL_2D``, ``ATT``, ``GEO``, at any size), TSPLIB's integer metric of the coordinates at each look-up
+  (:func:`_tsplib`, the formulas of :mod:`htetro_opt.scenarios.tsplib`). The kernel is compiled once per
+  kind (:func:`_d`), so the dense case pays nothing for the others.
 - **Neighbour lists**: each node's :data:`ILS_NEIGHBOURS` cheapest other nodes: from the matrix, or
   (implicit) the cheapest by eq. 2 among the ``4k`` nearest by the weighted centre of the blocks, a
-  k-d tree query (eq. 2 is at least Σw times the centres' distance). Each node's legs to its
-  neighbours are priced once per run.
-- **Start**: the nearest-neighbour tour from node 0 (dense), or the waypoints along a Hilbert curve
-  through their block centres (implicit: nearest neighbour needs every row of the matrix).
+  k-d tree query (eq. 2 is at least Σw times the centres' distance), or by the TSPLIB metric among the
+  ``4k`` nearest coordinates (GEO: points on the unit sphere); ties go to the lowest index, with the
+  matrix and without, so both give the same lists. Each node's legs to its neighbours are priced once
+  per run.
+- **Start**: the nearest-neighbour tour from node 0 (dense; a TSPLIB coordinate instance builds the same
+  tour with a k-d tree, from its start on an open path), or the waypoints along a Hilbert curve through
+  their block centres (implicit eq. 2: nearest neighbour needs every row of the matrix).
 - **Local search**: a queue of active nodes (the don't-look bits: a node whose moves all failed
   leaves the queue until an edge at it changes). For an active node ``a``, every 2-opt move that
   creates an edge from ``a`` (either tour direction) to a neighbour cheaper than the edge it
