@@ -25,7 +25,7 @@
 Run:  python benchmarks/bench_tsp.py [--quick] [--seeds N] [--budget S]
       [--parts agreement,ga,scale,backends,tsplib,tsplib-ga,obstacles,memory,versus,implicit]
       [--tsplib-dir DIR] [--names a,b] [--methods auto,fast-tsp]
-      [--implicit-n N] [--implicit-file F.tsp] [--variants "ils:neighbours=10|…"] [--no-lkh]
+      [--implicit-n N] [--implicit-file F.tsp] [--variants "ils:neighbours=10|…"] [--no-lkh] [--lkh-params P]
 
 7. Versus (issue 25, item 4): auto against fast-tsp at ``--budget`` seconds on TSPLIB instances of 400-2103
    cities (pcb442, pr1002 and those of VERSUS_OPTIMA found in ``--tsplib-dir``), gap to the optimum.
@@ -466,7 +466,7 @@ def _implicit_run(path: str, method: str, options: dict) -> dict:
             "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
 
 
-def _lkh_coordinates_run(path: str) -> dict:
+def _lkh_coordinates_run(path: str, params: str = "") -> dict:
     """In a fresh process: LKH-3 (elkai's solver, RUNS = 1) on the file's coordinates as TSPLIB text, so that
     LKH computes EUC_2D itself (no matrix: elkai's DistanceMatrix would hand it n² numbers as text)."""
     import resource
@@ -476,14 +476,17 @@ def _lkh_coordinates_run(path: str) -> dict:
     tsp = load_tsplib(path)
     text = Path(path).read_text().replace("EOF", "")
     began = time.perf_counter()
-    tour = [int(v) - 1 for v in _elkai.solve_problem("RUNS = 1\nPROBLEM_FILE = :stdin:\n", text)][:tsp.dimension]
+    extra = "".join(f"{item.strip()}\n" for item in params.split(";") if item.strip())
+    tour = [int(v) - 1 for v in _elkai.solve_problem(f"RUNS = 1\nPROBLEM_FILE = :stdin:\n{extra}", text)]
+    tour = tour[:tsp.dimension]
     done = time.perf_counter()
     assert sorted(tour) == list(range(tsp.dimension))
     return {"cost": _euc2d_tour(tsp.coords, tour), "seconds": done - began,
             "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
 
 
-def implicit(n: int, file: Path | None, variants: list[str], lkh: bool, time_limit: float = 60.0) -> None:
+def implicit(n: int, file: Path | None, variants: list[str], lkh: bool, lkh_params: str = "",
+             time_limit: float = 60.0) -> None:
     """Issue 25, item 4: a TSPLIB coordinate instance of ``n`` cities kept implicit, auto at 60 s against LKH."""
     import os
     import subprocess
@@ -525,8 +528,8 @@ def implicit(n: int, file: Path | None, variants: list[str], lkh: bool, time_lim
                   f"{row['cost']:.0f} | {row['peak_mb']:.0f} |", flush=True)
         print()
         if lkh and _installed("elkai"):
-            ref = fresh(_lkh_coordinates_run, str(path))
-            print(f"LKH-3 (elkai, RUNS = 1, EUC_2D coordinates): cost {ref['cost']:.0f} in {ref['seconds']:.1f} s, "
+            ref = fresh(_lkh_coordinates_run, str(path), lkh_params)
+            print(f"LKH-3 (elkai, RUNS = 1, EUC_2D coordinates{'; ' + lkh_params if lkh_params else ''}): cost {ref['cost']:.0f} in {ref['seconds']:.1f} s, "
                   f"peak RSS {ref['peak_mb']:.0f} MB\n")
             print("Gap to LKH in %: " + ", ".join(f"{label} {100 * (r['cost'] / ref['cost'] - 1):.2f}"
                                                 for label, r in results.items()) + "\n")
@@ -548,6 +551,8 @@ def main() -> None:
                         help="implicit: a TSPLIB EUC_2D file (e.g. a public instance in /tmp) instead of the generated one")
     parser.add_argument("--variants", default="", help="implicit: more runs, '|'-separated, e.g. ils:neighbours=10")
     parser.add_argument("--no-lkh", action="store_true", help="implicit: skip the LKH reference")
+    parser.add_argument("--lkh-params", default="", help="implicit: more LKH parameters, ';'-separated, e.g. "
+                        "'CANDIDATE_SET_TYPE = POPMUSIC;TIME_LIMIT = 300' (its default run takes over an hour at 16 384)")
     args = parser.parse_args()
     print(f"# Le et al. 2018 benchmark ({platform.python_version()}, {platform.processor() or platform.machine()})\n")
     parts = args.parts.split(",")
@@ -571,7 +576,8 @@ def main() -> None:
     if "obstacles" in parts:
         obstacles(30.0)
     if "implicit" in parts:
-        implicit(args.implicit_n, args.implicit_file, [v for v in args.variants.split("|") if v], not args.no_lkh)
+        implicit(args.implicit_n, args.implicit_file, [v for v in args.variants.split("|") if v], not args.no_lkh,
+                 args.lkh_params)
     if "versus" in parts:
         versus(args.budget, args.tsplib_dir, [n for n in args.names.split(",") if n], args.methods.split(","))
 
