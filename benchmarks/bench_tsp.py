@@ -529,7 +529,9 @@ def implicit(n: int, file: Path | None, variants: list[str], lkh: bool, lkh_para
         print()
         if lkh and _installed("elkai"):
             ref = fresh(_lkh_coordinates_run, str(path), lkh_params)
-            print(f"LKH-3 (elkai, RUNS = 1, EUC_2D coordinates{'; ' + lkh_params if lkh_params else ''}): cost {ref['cost']:.0f} in {ref['seconds']:.1f} s, "
+            given = f"; {lkh_params}" if lkh_params else ""
+            print(f"LKH-3 (elkai, RUNS = 1, EUC_2D coordinates{given}): cost {ref['cost']:.0f} in "
+                  f"{ref['seconds']:.1f} s, "
                   f"peak RSS {ref['peak_mb']:.0f} MB\n")
             print("Gap to LKH in %: " + ", ".join(f"{label} {100 * (r['cost'] / ref['cost'] - 1):.2f}"
                                                 for label, r in results.items()) + "\n")
@@ -548,11 +550,11 @@ def main() -> None:
                         help="versus: the columns, among auto, fast-tsp and ils-kicks=K")
     parser.add_argument("--implicit-n", type=int, default=16384, help="implicit: cities of the generated instance")
     parser.add_argument("--implicit-file", type=Path, default=None,
-                        help="implicit: a TSPLIB EUC_2D file (e.g. a public instance in /tmp) instead of the generated one")
+                        help="implicit: a TSPLIB EUC_2D file (e.g. a public one in /tmp) instead of the generated one")
     parser.add_argument("--variants", default="", help="implicit: more runs, '|'-separated, e.g. ils:neighbours=10")
     parser.add_argument("--no-lkh", action="store_true", help="implicit: skip the LKH reference")
     parser.add_argument("--lkh-params", default="", help="implicit: more LKH parameters, ';'-separated, e.g. "
-                        "'CANDIDATE_SET_TYPE = POPMUSIC;TIME_LIMIT = 300' (its default run takes over an hour at 16 384)")
+                        "'CANDIDATE_SET_TYPE = POPMUSIC;TIME_LIMIT = 300' (its default run: over an hour at 16 384)")
     args = parser.parse_args()
     print(f"# Le et al. 2018 benchmark ({platform.python_version()}, {platform.processor() or platform.machine()})\n")
     parts = args.parts.split(",")

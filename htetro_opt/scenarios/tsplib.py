@@ -167,7 +167,7 @@ def tsplib_legs(coords, edge_weight_type: str, a, b) -> np.ndarray:
 
     Examples
     --------
-    >>> tsplib_legs([[0, 0], [3, 4], [1, 1]], "EUC_2D", [0, 0, 2], [1, 2, 2]).tolist()   # √2 → 1; a node to itself 0
+    >>> tsplib_legs([[0, 0], [3, 4], [1, 1]], "EUC_2D", [0, 0, 2], [1, 2, 2]).tolist()   # √2 → 1; itself 0
     [5.0, 1.0, 0.0]
     """
     kind, x = _check_coordinates(coords, edge_weight_type)

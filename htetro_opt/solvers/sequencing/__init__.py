@@ -34,7 +34,8 @@ from htetro_opt._lazy import attach
 __getattr__, __dir__, __all__ = attach(__name__, {
     "sequence_waypoints": "._dispatch", "SequenceResult": "._dispatch", "SPEC": "._spec",
     "EXACT_AUTO_LIMIT": "._spec", "ASYMMETRIC_METHODS": "._dispatch",
-    "auto_method": "._dispatch", "MATRIX_BYTES_PER_ENTRY": "._dispatch", "MATRIX_BYTES_DEFAULT": "._dispatch", "default_time_limit": "._budgets", "TIME_LIMIT_TEXT": "._budgets",
+    "auto_method": "._dispatch", "MATRIX_BYTES_PER_ENTRY": "._dispatch", "MATRIX_BYTES_DEFAULT": "._dispatch",
+    "default_time_limit": "._budgets", "TIME_LIMIT_TEXT": "._budgets",
     "solve_exact": "._exact", "held_karp": "._exact", "EXACT_MAX_SIZE": "._spec",
     "solve_ortools": "._ortools", "ortools_time_limit": "._ortools", "FIRST_SOLUTIONS": "._spec",
     "solve_local": "._local", "nearest_neighbour": "._local", "nearest_neighbour_paths": "._local",

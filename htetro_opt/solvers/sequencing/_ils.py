@@ -667,7 +667,8 @@ def _cost_model(instance: SequencingInstance) -> tuple[tuple, int, int | None, f
 
     ``cm`` for :func:`_d`: the dense matrix of ``m`` nodes (the instance's symmetrised, plus the
     dummy), or, for an implicit instance, the block cells ``P`` and weights ``w`` (eq. 2) or the
-    coordinates ``X`` and the metric's code ``kind`` (TSPLIB), and the dummy's legs ``pen``; ``dummy`` is the dummy's index (None: closed); ``top``
+    coordinates ``X`` and the metric's code ``kind`` (TSPLIB), and the dummy's legs ``pen``; ``dummy`` is the
+    dummy's index (None: closed); ``top``
     bounds every leg's cost.
     """
     n = instance.n
