@@ -39,6 +39,7 @@ Run:  python benchmarks/bench_tsp.py [--quick] [--seeds N] [--budget S]
 from __future__ import annotations
 
 import argparse
+import ast
 import platform
 import statistics
 import time
@@ -314,6 +315,11 @@ def versus(budget: float, tsplib_dir: Path | None, names: list[str] | None, meth
     runs = {"auto": ("auto", {"time_limit": budget, "seed": 0}), "fast-tsp": ("fast-tsp", {"time_limit": budget})}
     runs.update({f"ils-kicks={k}": ("ils", {"kicks": int(k), "seed": 0, "time_limit": 10 * budget})
                  for k in (m.split("=")[1] for m in methods if m.startswith("ils-kicks="))})
+    for m in methods:  # a lever against the default: auto[or3opt=True;kick_rate=1e5] (options as Python literals)
+        if m.endswith("]") and "[" in m:
+            base, _, args = m[:-1].partition("[")
+            options = {k: ast.literal_eval(v) for k, v in (kv.split("=") for kv in args.split(";") if kv)}
+            runs[m] = (base, {**runs[base][1], **options})
     labels = [m for m in methods if m in runs]
     print(f"## auto against fast-tsp, {budget:g} s each, closed tours: gap to the published optimum in % (seconds)\n")
     print("| instance | n | optimum | " + " | ".join(labels) + " |")
@@ -547,7 +553,7 @@ def main() -> None:
                         help="versus: a folder holding more TSPLIB files (name.tsp) of VERSUS_OPTIMA")
     parser.add_argument("--names", default="", help="versus: only these instances (comma-separated)")
     parser.add_argument("--methods", default="auto,fast-tsp",
-                        help="versus: the columns, among auto, fast-tsp and ils-kicks=K")
+                        help="versus: the columns, among auto, fast-tsp, ils-kicks=K and auto[option=value;...]")
     parser.add_argument("--implicit-n", type=int, default=16384, help="implicit: cities of the generated instance")
     parser.add_argument("--implicit-file", type=Path, default=None,
                         help="implicit: a TSPLIB EUC_2D file (e.g. a public one in /tmp) instead of the generated one")

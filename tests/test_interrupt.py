@@ -173,12 +173,14 @@ def test_a_set_flag_stops_the_ils_kernel_and_a_clear_one_changes_nothing():
     ils, cm, nbr, eps, m = _ils_case()
     start = np.arange(m, dtype=np.int64)
     free = start.copy()
-    for depth in (0, 2):  # the 2-opt moves and the LK-style move (lk_depth) alike
+    for depth in (0, 2):  # the 2-opt moves and the LK-style move (lk_depth, here with or3opt) alike
         halted = start.copy()
         halt = np.ones(1, np.uint8)
-        assert ils._ils(cm, nbr, halted, 500, ils.ILS_KICK_SPAN, np.uint64(7), eps, halt, depth) == (0, 0)
+        assert ils._ils(cm, nbr, halted, 500, ils.ILS_KICK_SPAN, np.uint64(7), eps, halt, depth, depth == 2,
+                        0.0) == (0, 0)
         assert halted.tolist() == start.tolist()  # not one move: the flag is read before the first
-    done, _ = ils._ils(cm, nbr, free, 500, ils.ILS_KICK_SPAN, np.uint64(7), eps, np.zeros(1, np.uint8), 0)
+    done, _ = ils._ils(cm, nbr, free, 500, ils.ILS_KICK_SPAN, np.uint64(7), eps, np.zeros(1, np.uint8), 0,
+                       False, 0.0)
     assert done == 500 and ils._tour_cost(cm, free) < ils._tour_cost(cm, start)
     stuck = start.copy()
     assert ils._descend(cm, nbr, ils._neighbour_costs(cm, nbr), stuck, True, np.arange(1, 4), True, eps,

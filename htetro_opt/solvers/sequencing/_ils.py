@@ -66,16 +66,15 @@ import numpy as np
 
 from htetro_opt._interrupt import kernel_flag
 from htetro_opt._jit import require_numba
-from htetro_opt._validation import as_rng, check_int, check_time_limit
+from htetro_opt._validation import as_rng, check_bool, check_int, check_real, check_time_limit
 from htetro_opt.errors import ParameterError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance, eq2_legs
 from htetro_opt.solvers.sequencing._budgets import default_time_limit
-from htetro_opt.solvers.sequencing._spec import ILS_LK_DEPTH, ILS_NEIGHBOURS
+from htetro_opt.solvers.sequencing._spec import (ILS_ACCEPT_WORSE, ILS_KICK_RATE, ILS_KICK_SPAN, ILS_LK_DEPTH,
+                                                  ILS_NEIGHBOURS, ILS_OR3OPT)
 
 __all__ = ["ILS_KICK_SPAN", "LocalCore", "ils_kicks", "solve_ils"]
 
-ILS_KICK_SPAN = 100
-"""Longest segment of a kick's double bridge (each of its three segments has 1…this many nodes)."""
 
 _UNLIMITED = 1 << 62
 """A move budget that never runs out."""
@@ -393,15 +392,79 @@ def _lk_move(cm, nbr, nc, tour, pos, log, count, t1, back, depth, eps, touched, 
 
 
 @_jit
+def _or3_move(cm, nbr, nc, tour, pos, log, count, t1, back, eps, touched):
+    """A sequential 3-opt move from ``t1`` that no pair of 2-opt flips along the chain reaches: the
+    segment exchange (or-3opt): (gain, moves logged, nodes touched, in ``touched[:returned]``); gain 0 and
+    the tour unchanged when none gains.
+
+    Break (t1, t2), t2 the successor (``back`` 0) or predecessor of t1; add (t2, t3), t3 a neighbour of t2
+    whose leg leaves a positive partial gain; break (t3, t4), t4 the neighbour of t3 *away* from t2's side
+    (the choice a 2-opt flip cannot close), which leaves the segment S = t2 … t3 as a cycle and the rest as
+    a path t4 … t1; add (t4, t5), t5 a neighbour of t4 inside S, and break an edge (t5, t6) of S: t6 after
+    t5 gives the two halves of S swapped (t1 t6 … t3 t2 … t5 t4), t6 before t5 the two halves reversed in
+    place (t1 t6 … t2 t3 … t5 t4). The first closing that gains is made (three or two flips, logged).
+    """
+    n = tour.shape[0]
+    k = nbr.shape[1]
+    s = 1 if back == 0 else -1
+    t2 = tour[(pos[t1] + s) % n]
+    d12 = _d(cm, t1, t2)
+    for j0 in range(k):
+        g1 = d12 - nc[t2, j0]
+        if g1 <= eps:  # sorted lists: no later t3 leaves a gain
+            break
+        t3 = nbr[t2, j0]
+        if t3 == t1:
+            continue
+        span = ((pos[t3] - pos[t2]) * s) % n  # S = t2 … t3 in direction s: positions 0 … span
+        if span < 1 or span >= n - 2:  # S one node, or t4 would be t1
+            continue
+        t4 = tour[(pos[t3] + s) % n]
+        g2 = g1 + _d(cm, t3, t4)
+        for j in range(k):
+            g3 = g2 - nc[t4, j]
+            if g3 <= eps:
+                break
+            t5 = nbr[t4, j]
+            off = ((pos[t5] - pos[t2]) * s) % n
+            if off > span:  # not in S
+                continue
+            if off < span:  # t6 after t5: the halves t2 … t5 and t6 … t3 swapped
+                t6 = tour[(pos[t5] + s) % n]
+                gain = g3 + _d(cm, t5, t6) - _d(cm, t6, t1)
+                if gain > eps:
+                    _two_opt(tour, pos, t1, t2, t3, t4)  # t1 [t3 … t6][t5 … t2] t4
+                    count = _log(log, count, t1, t2, t3, t4)
+                    _two_opt(tour, pos, t1, t3, t6, t5)  # t1 [t6 … t3][t5 … t2] t4
+                    count = _log(log, count, t1, t3, t6, t5)
+                    _two_opt(tour, pos, t3, t5, t2, t4)  # t1 [t6 … t3][t2 … t5] t4
+                    count = _log(log, count, t3, t5, t2, t4)
+                    touched[0], touched[1], touched[2], touched[3], touched[4], touched[5] = t1, t2, t3, t4, t5, t6
+                    return gain, count, 6
+            if off > 0:  # t6 before t5: both halves reversed in place
+                t6 = tour[(pos[t5] - s) % n]
+                gain = g3 + _d(cm, t5, t6) - _d(cm, t6, t1)
+                if gain > eps:
+                    _two_opt(tour, pos, t1, t2, t6, t5)  # t1 [t6 … t2][t5 … t3] t4
+                    count = _log(log, count, t1, t2, t6, t5)
+                    _two_opt(tour, pos, t2, t5, t3, t4)  # t1 [t6 … t2][t3 … t5] t4
+                    count = _log(log, count, t2, t5, t3, t4)
+                    touched[0], touched[1], touched[2], touched[3], touched[4], touched[5] = t1, t2, t3, t4, t5, t6
+                    return gain, count, 6
+    return 0.0, count, 0
+
+
+@_jit
 def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count, eps, opt2, lengths, full,
-                  budget, halt, lk):
+                  budget, halt, lk, or3):
     """Improve the tour from the queued nodes until the queue is empty or ``budget`` moves are made:
     (gain, head, moves logged, moves made). Stops early when ``halt[0]`` is set (a signal, see
     :func:`htetro_opt._interrupt.kernel_flag`; the caller's result is then thrown away).
 
     ``opt2``: try 2-opt moves; ``lengths``: the Or-opt segment lengths, ascending (empty: no Or-opt);
     ``lk``: with ``opt2`` and not ``full``, the LK-style moves of :func:`_lk_move` of at most ``lk``
-    flips in place of the 2-opt moves (0: 2-opt).
+    flips in place of the 2-opt moves (0: 2-opt); ``or3``: with ``opt2`` and not ``full``, then the segment
+    exchanges of :func:`_or3_move` where no 2-opt (LK) or Or-opt move gains.
     Restricted (``full`` False, the ILS): a node's candidates are its neighbour list ``nbr`` (legs
     ``nc``, cheapest first), and the scan of a list stops at the first neighbour whose leg leaves no
     gain. ``full``: every other node is a candidate and nothing is pruned, so that a pass from every
@@ -411,7 +474,7 @@ def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count,
     k = n - 1 if full else nbr.shape[1]
     gain_total = 0.0
     moves = 0
-    touched = np.empty(2 * max(lk, 2) + 2, dtype=np.int64)
+    touched = np.empty(2 * max(lk, 3) + 2, dtype=np.int64)
     added = np.empty((max(lk, 1), 2), dtype=np.int64)
     while size > 0 and moves < budget:
         if halt[0]:  # one byte read a node: nothing next to the node's scan of its candidates
@@ -541,6 +604,16 @@ def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count,
                             break
                     if improved:
                         break
+        if improved or not or3 or full or not opt2:
+            continue
+        for direction in range(2):
+            gain, count, nt = _or3_move(cm, nbr, nc, tour, pos, log, count, a, direction, eps, touched)
+            if gain > eps:
+                gain_total += gain
+                moves += 1
+                for t in range(nt):
+                    size = _push(queue, queued, head, size, touched[t])
+                break
     return gain_total, head, count, moves
 
 
@@ -588,15 +661,18 @@ def _descend(cm, nbr, nc, tour, opt2, lengths, full, eps, budget, halt):
         size = _push(queue, queued, 0, size, tour[i])
     log = np.empty((0, 4), dtype=np.int64)  # nothing is undone: no move is logged
     _, _, _, moves = _local_search(cm, nbr, nc, tour, pos, queue, queued, 0, size, log, 0, eps, opt2, lengths,
-                                   full, budget, halt, 0)
+                                   full, budget, halt, 0, False)
     return moves
 
 
 @_jit
-def _ils(cm, nbr, tour, kicks, span, seed, eps, halt, lk):
+def _ils(cm, nbr, tour, kicks, span, seed, eps, halt, lk, or3, worse):
     """Local search, then ``kicks`` kicks (double bridges); the tour in place. Returns (kicks done,
     kicks that lowered the cost). Stops early when ``halt[0]`` is set (see :func:`_local_search`).
-    ``lk``: the depth of the LK-style moves that replace the 2-opt moves (0: 2-opt, :func:`_lk_move`)."""
+    ``lk``: the depth of the LK-style moves that replace the 2-opt moves (0: 2-opt, :func:`_lk_move`);
+    ``or3``: the segment exchanges of :func:`_or3_move` too; ``worse``: a kick's result is kept when it is
+    at most ``worse`` mean legs (of the start tour) above the best tour of the run, which the tour is set
+    back to at the end (0: kept when no costlier than the current tour, which is then always the best)."""
     n = tour.shape[0]
     pos = np.empty(n, dtype=np.int64)
     for i in range(n):
@@ -613,13 +689,21 @@ def _ils(cm, nbr, tour, kicks, span, seed, eps, halt, lk):
     for i in range(n):
         size = _push(queue, queued, head, size, tour[i])
     _, head, _, _ = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, 0, eps, True, lengths,
-                                  False, _UNLIMITED, halt, lk)
+                                  False, _UNLIMITED, halt, lk, or3)
     size = 0
     kept = 0
     done = 0
     if n < 8:
         return done, kept
     span = min(span, (n - 2) // 3)
+    walk = worse > 0.0
+    best = np.empty(n if walk else 0, dtype=np.int64)
+    cur = best_cost = 0.0
+    allowance = 0.0
+    if walk:
+        best[:] = tour
+        cur = best_cost = _tour_cost(cm, tour)
+        allowance = worse * cur / n
     for _ in range(kicks):
         if halt[0]:
             break
@@ -646,9 +730,17 @@ def _ils(cm, nbr, tour, kicks, span, seed, eps, halt, lk):
         for node in (a1, b1, b2, c1, c2, d1):
             size = _push(queue, queued, head, size, node)
         gain, head, count, _ = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count, eps,
-                                             True, lengths, False, _UNLIMITED, halt, lk)
+                                             True, lengths, False, _UNLIMITED, halt, lk, or3)
         size = 0
-        if delta - gain <= eps and count <= log.shape[0]:
+        if walk:
+            if cur + delta - gain <= best_cost + allowance + eps and count <= log.shape[0]:
+                cur += delta - gain
+                if cur < best_cost - eps:
+                    best_cost = cur
+                    best[:] = tour
+                    kept += 1
+                continue
+        elif delta - gain <= eps and count <= log.shape[0]:
             if delta - gain < -eps:
                 kept += 1
             continue
@@ -658,6 +750,8 @@ def _ils(cm, nbr, tour, kicks, span, seed, eps, halt, lk):
         for m in range(count - 1, -1, -1):
             a, b, c, d = log[m, 0], log[m, 1], log[m, 2], log[m, 3]
             _two_opt(tour, pos, a, c, b, d)
+    if walk and best_cost < cur - eps:
+        tour[:] = best
     return done, kept
 
 
@@ -910,7 +1004,9 @@ def _costs_kind(instance) -> str:
 
 
 def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int | None = None,
-              neighbours: int = ILS_NEIGHBOURS, lk_depth: int = ILS_LK_DEPTH) -> tuple[np.ndarray, dict]:
+              neighbours: int = ILS_NEIGHBOURS, lk_depth: int = ILS_LK_DEPTH, or3opt: bool = ILS_OR3OPT,
+              kick_rate: float = ILS_KICK_RATE, accept_worse: float = ILS_ACCEPT_WORSE,
+              kick_span: int = ILS_KICK_SPAN) -> tuple[np.ndarray, dict]:
     """Iterated local search (2-opt + Or-opt, local double-bridge kicks), compiled and seeded.
 
     Parameters
@@ -932,6 +1028,19 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     lk_depth : int
         Flips of the LK-style move that replaces the 2-opt moves (0, the default: plain 2-opt; 2: 2-opt
         and sequential 3-opt moves, stronger a kick and about twice as slow, see ``ILS_LK_DEPTH``).
+    or3opt : bool
+        Add the segment exchanges of :func:`_or3_move` (sequential 3-opt moves no 2-opt flip pair reaches)
+        to the local search (``ILS_OR3OPT``).
+    kick_rate : float
+        With an explicit ``time_limit`` and ``kicks`` None: kicks planned a second of the limit, the
+        budget ``max(ils_kicks(n), kick_rate · time_limit)``, a number fixed by the arguments, so the run
+        is reproducible when it completes within the limit (0: :func:`ils_kicks` alone; ``ILS_KICK_RATE``).
+    accept_worse : float
+        Keep a kick's result when it is at most this many mean legs above the run's best tour, which is
+        returned (0: only when no costlier, ``ILS_ACCEPT_WORSE``).
+    kick_span : int
+        Longest segment of a kick's double bridge (:data:`ILS_KICK_SPAN`; ``n // 4`` or more: a global
+        double bridge).
 
     Returns
     -------
@@ -960,9 +1069,14 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     if not instance.symmetric:
         raise ParameterError("method 'ils' assumes a symmetric cost matrix: use one of lkh, ortools, exact, greedy")
     time_limit = check_time_limit(time_limit)
+    explicit = time_limit is not None
     if time_limit is None:
         time_limit = default_time_limit("ils", instance.n)
     kicks = check_int(kicks, "kicks", minimum=0, allow_none=True)
+    kick_rate = check_real(kick_rate, "kick_rate", minimum=0.0)
+    accept_worse = check_real(accept_worse, "accept_worse", minimum=0.0)
+    kick_span = check_int(kick_span, "kick_span", minimum=1)
+    or3opt = check_bool(or3opt, "or3opt")
     neighbours = check_int(neighbours, "neighbours", minimum=1)
     rng = as_rng(seed)
     stream = int(rng.integers(0, 2**63))
@@ -970,6 +1084,8 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     cm, m, dummy, top = _cost_model(instance)
     if kicks is None:
         kicks = ils_kicks(m)
+        if explicit and kick_rate > 0:  # plan to use the limit the caller gave, in a number of kicks
+            kicks = max(kicks, int(kick_rate * time_limit))
     if m < 8:  # every tour through node 0, no kick can help
         from itertools import permutations
 
@@ -1002,8 +1118,8 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     halt = kernel_flag()  # set by SIGINT / SIGTERM under the command line: the kernel returns within moments
     while first or done < kicks:
         step = min(chunk, kicks - done)
-        d, k = _ils(cm, nbr, tour, step, ILS_KICK_SPAN, np.uint64((stream + 0x9E37 * done) % 2**64), eps, halt,
-                    lk_depth)
+        d, k = _ils(cm, nbr, tour, step, kick_span, np.uint64((stream + 0x9E37 * done) % 2**64), eps, halt,
+                    lk_depth, or3opt, float(accept_worse))
         first = False
         done += d
         kept += k
@@ -1076,7 +1192,8 @@ class LocalCore:
             return order
         tour = order if self.dummy is None else np.append(order, self.dummy)
         tour = np.ascontiguousarray(tour, dtype=np.int64)
-        _ils(self.cm, self.nbr, tour, int(kicks), ILS_KICK_SPAN, np.uint64(seed % 2**64), self.eps, kernel_flag(), 0)
+        _ils(self.cm, self.nbr, tour, int(kicks), ILS_KICK_SPAN, np.uint64(seed % 2**64), self.eps, kernel_flag(), 0,
+             False, 0.0)
         return _decode(tour, self.dummy, self.instance)
 
     def descend(self, order, *, two_opt: bool = True, lengths=(1, 2, 3), certify: bool = True,

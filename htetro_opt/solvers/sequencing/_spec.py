@@ -20,7 +20,8 @@ from htetro_opt.solvers.sequencing._budgets import TIME_LIMIT_TEXT
 from htetro_opt.solvers.tiling._spec import shape_letters  # a scenario is tiled first: its shapes are the tiler's
 
 __all__ = ["SPEC", "is_tileset", "GA_ADDITIONS", "EXACT_AUTO_LIMIT", "EXACT_MAX_SIZE", "EXACT_TIME_LIMIT", "FAST_TSP_CANDIDATES",
-           "FIRST_SOLUTIONS", "ILS_LK_DEPTH", "ILS_NEIGHBOURS"]
+           "FIRST_SOLUTIONS", "ILS_ACCEPT_WORSE", "ILS_KICK_RATE", "ILS_KICK_SPAN", "ILS_LK_DEPTH", "ILS_NEIGHBOURS",
+           "ILS_OR3OPT"]
 
 EXACT_AUTO_LIMIT = 40
 """``auto`` proves the optimum with the exact solver up to this many waypoints (a closed tour counts
@@ -51,6 +52,20 @@ ILS_LK_DEPTH = 0
 kick (pr1002 at 100 kicks a node: 0.15 % above the optimum against 0.51 %) but costs about twice the time a
 kick, and at 10 s its mean gap equals the 2-opt search's (0.385 % both); deeper is slower still. So the
 default stays 0, and the runtimes of large instances at their kick budget stay where they were."""
+
+ILS_OR3OPT = False
+"""Whether ``ils``'s local search adds the segment exchange (or-3opt) moves. (measured: to be filled)"""
+
+ILS_KICK_SPAN = 100
+"""Longest segment of a kick's double bridge in ``ils`` (each of its three segments has 1…this many nodes)."""
+
+ILS_ACCEPT_WORSE = 0.0
+"""How far above its best tour, in mean legs, ``ils`` keeps a kick's result (0: only when no costlier).
+(measured: to be filled)"""
+
+ILS_KICK_RATE = 0.0
+"""Kicks ``ils`` plans a second of an explicit ``time_limit`` (0: its :func:`ils_kicks` budget alone).
+(measured: to be filled)"""
 
 FIRST_SOLUTIONS = (
     "AUTOMATIC", "PATH_CHEAPEST_ARC", "PATH_MOST_CONSTRAINED_ARC", "SAVINGS", "PARALLEL_SAVINGS",
@@ -131,6 +146,14 @@ OPTIONS = (
     Option("neighbours", integer(1), "size of each node's candidate list", default=ILS_NEIGHBOURS, flag=""),
     Option("lk_depth", integer(0), "flips of ils's Lin-Kernighan-style move (0: its 2-opt moves; 2: 2-opt and "
            "sequential 3-opt, stronger a kick, slower)", default=ILS_LK_DEPTH, type=int, metavar="N"),
+    Option("or3opt", check_bool, "ils: add the segment-exchange (or-3opt) moves to the local search",
+           default=ILS_OR3OPT, type=bool, flag="--or3opt", off_flag="--no-or3opt"),
+    Option("kick_rate", real(0.0), "ils: kicks planned a second of an explicit time limit (0: the kicks sized to "
+           "the instance only)", default=ILS_KICK_RATE, type=float, metavar="K"),
+    Option("accept_worse", real(0.0), "ils: keep a kick's result up to this many mean legs above the best tour",
+           default=ILS_ACCEPT_WORSE, flag=""),
+    Option("kick_span", integer(1), "ils: longest segment of a kick's double bridge", default=ILS_KICK_SPAN,
+           flag=""),
     Option("pop_size", integer(2), "population size", default=60, flag=""),
     Option("max_gen", integer(0), "generations at most", default=2000, flag=""),
     Option("patience", integer(1, none=True), "generations without improvement before stopping", default=200,
@@ -169,7 +192,8 @@ _PATTERN = dict(capabilities={"asymmetric", "geometry"}, origin="baseline", pape
 METHODS = (
     # auto runs exact, ils or ortools (auto_method): it takes their options and hands each the ones it takes
     Method("auto", None, f"exact up to {EXACT_AUTO_LIMIT} waypoints, ils beyond (ortools for asymmetric costs)",
-           ("seed", "time_limit", "progress", "max_size", "kicks", "neighbours", "lk_depth", "scale",
+           ("seed", "time_limit", "progress", "max_size", "kicks", "neighbours", "lk_depth", "or3opt",
+            "kick_rate", "accept_worse", "kick_span", "scale",
             "first_solution",
             "solution_limit"),
            seeded=True, capabilities={"asymmetric", "tours", "implicit"}),
@@ -182,7 +206,8 @@ METHODS = (
            ("seed", "time_limit", "progress", "restarts", "max_starts"),
            seeded=lambda options: options.get("restarts", 0) > 0, capabilities={"progress"}),
     Method("ils", "._ils:solve_ils", "the compiled, seeded iterated local search (2-opt, Or-opt, double-bridge "
-           "kicks)", ("seed", "time_limit", "kicks", "neighbours", "lk_depth"), seeded=True,
+           "kicks)", ("seed", "time_limit", "kicks", "neighbours", "lk_depth", "or3opt", "kick_rate",
+           "accept_worse", "kick_span"), seeded=True,
            capabilities={"tours", "implicit"}),
     Method("ga", "._ga:solve_ga", "the paper's GA on DEAP with our additions (order crossover, distinct "
            "survivors, a 2-opt/Or-opt step)", _GA, defaults={"additions": tuple(GA_ADDITIONS), "patience": 50},

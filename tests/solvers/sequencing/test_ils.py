@@ -233,3 +233,90 @@ def test_the_lk_move_reaches_the_optimum_and_repeats_by_seed():
     inst = SequencingInstance.from_matrix(euclidean(300, 3), closed=True)
     plain, deep = (sequence_waypoints(inst, method="ils", seed=5, kicks=2_000, lk_depth=d) for d in (0, 2))
     assert not np.array_equal(plain.order, deep.order)
+
+def test_the_segment_exchange_gains_what_a_repricing_loop_says_and_undoes_exactly():
+    """The or-3opt move (:func:`_or3_move`, ``or3opt``): on random tours of a Euclidean instance its gain is
+    the fall of the tour's cost re-priced by a plain loop, the tour stays a permutation with consistent
+    positions, both closings occur (the halves swapped, three flips; reversed in place, two), and the
+    logged flips undone in reverse order give back the tour's cost before the move."""
+    from htetro_opt.solvers.sequencing import _ils
+
+    n = 90
+    C = euclidean(n, 22)
+    nbr = _ils._neighbour_lists(C, 8)
+    nc = _ils._neighbour_costs(C, nbr)
+    rng = np.random.default_rng(1)
+
+    def loop_cost(tour):
+        return sum(C[tour[i], tour[(i + 1) % n]] for i in range(n))
+
+    flips = set()
+    for _ in range(12):
+        tour = rng.permutation(n).astype(np.int64)
+        pos = np.empty(n, dtype=np.int64)
+        pos[tour] = np.arange(n)
+        log = np.empty((4 * n + 64, 4), dtype=np.int64)
+        touched = np.empty(8, dtype=np.int64)
+        for t1 in range(n):
+            for back in (0, 1):
+                before = loop_cost(tour)
+                gain, count, nt = _ils._or3_move(C, nbr, nc, tour, pos, log, 0, t1, back, 1e-9, touched)
+                assert sorted(tour.tolist()) == list(range(n)) and np.array_equal(pos[tour], np.arange(n))
+                after = loop_cost(tour)
+                assert before - after == pytest.approx(gain, abs=1e-9) and gain >= 0
+                if gain > 0:
+                    flips.add(int(count))
+                    assert nt == 6 and t1 in touched[:nt]
+                    undone = tour.copy()
+                    back_pos = pos.copy()
+                    for m in range(count - 1, -1, -1):
+                        a, b, c, d = log[m]
+                        _ils._two_opt(undone, back_pos, a, c, b, d)
+                    assert loop_cost(undone) == pytest.approx(before, abs=1e-9)
+    assert flips == {2, 3}
+
+
+@pytest.mark.parametrize("options", [{"or3opt": True}, {"accept_worse": 0.2}, {"kick_span": 10},
+                                     {"or3opt": True, "lk_depth": 2, "kick_span": 7}])
+def test_the_search_options_keep_a_valid_tour_priced_right_and_repeat_by_seed(options):
+    """``or3opt``, ``accept_worse`` and ``kick_span`` (off or at their defaults in ``ILS_*``): the same seed
+    gives the same tour when the kicks complete, the reported cost is the re-priced tour's, no tour is
+    below the proven optimum of berlin52 (7542, TSPLIB) and each option reaches the kernel (another walk
+    than the default's on 300 nodes)."""
+    from pathlib import Path
+
+    from htetro_opt.scenarios.tsplib import load_tsplib
+
+    tsp = load_tsplib(Path(__file__).resolve().parents[3] / "benchmarks" / "data" / "tsplib" / "berlin52.tsp")
+    inst = SequencingInstance.from_matrix(tsp.cost, closed=True, start=0)
+    # (a generous cap: the first call may compile the kernel, which counts against the limit)
+    a, b = (sequence_waypoints(inst, method="ils", seed=3, kicks=3_000, time_limit=600, **options) for _ in range(2))
+    assert np.array_equal(a.order, b.order) and not a.info["timed_out"] and a.info["kicks"] == 3_000
+    order = a.order.tolist()
+    assert sorted(order) == list(range(52))
+    priced = sum(tsp.cost[order[i], order[(i + 1) % 52]] for i in range(52))
+    assert a.cost == pytest.approx(priced, rel=1e-12) and priced >= 7542 - 1e-9
+    assert priced <= 1.03 * 7542
+    big = SequencingInstance.from_matrix(euclidean(300, 3), closed=True)
+    plain, other = (sequence_waypoints(big, method="ils", seed=5, kicks=2_000, **o) for o in ({}, options))
+    assert not np.array_equal(plain.order, other.order)
+
+
+def test_an_explicit_time_limit_sets_a_kick_budget_that_repeats_when_it_completes():
+    """``kick_rate``: with an explicit ``time_limit`` and no ``kicks`` the budget is max(ils_kicks(n),
+    kick_rate · time_limit), a number, so the same seed gives the same tour when it completes; without a
+    limit (or at rate 0) it stays ils_kicks(n)."""
+    inst = SequencingInstance.from_matrix(euclidean(60, 4), closed=True)
+    runs = [sequence_waypoints(inst, method="ils", seed=2, time_limit=600, kick_rate=100) for _ in range(2)]
+    assert all(r.info["kicks"] == 60_000 and not r.info["timed_out"] for r in runs)
+    assert np.array_equal(runs[0].order, runs[1].order)
+    assert sequence_waypoints(inst, method="ils", seed=2, kick_rate=100).info["kicks"] == ils_kicks(60)
+    assert sequence_waypoints(inst, method="ils", seed=2, time_limit=600, kick_rate=0).info["kicks"] == ils_kicks(60)
+    assert sequence_waypoints(inst, method="ils", seed=2, time_limit=1, kick_rate=10).info["kicks"] == ils_kicks(60)
+
+
+@pytest.mark.parametrize("bad", [{"kick_rate": -1.0}, {"accept_worse": -0.5}, {"kick_span": 0}, {"or3opt": "yes"}])
+def test_bad_search_options_are_refused_before_work(bad):
+    inst = SequencingInstance.from_matrix(euclidean(30, 1), closed=True)
+    with pytest.raises(ParameterError, match=next(iter(bad))):
+        sequence_waypoints(inst, method="ils", **bad)
