@@ -954,7 +954,7 @@ def test_study_table4_prints_ours_beside_the_papers(capsys, tmp_path):
 
 def test_study_le2018_runs_on_the_runner_and_resumes(capsys, tmp_path):
     out_dir = tmp_path / "out"
-    argv = ["study", "le2018", "--seeds", "1", "--time-limit", "0.5", "--out", str(out_dir)]
+    argv = ["study", "le2018", "--seeds", "1", "--time-limit", "0.2", "--out", str(out_dir)]
     code, out, err = run(capsys, argv)
     assert code == 0, err
     assert out.count("### Table") >= 5 and "Exact (CP-SAT)" in out
