@@ -179,6 +179,29 @@ def test_a_free_256_map_tiles_and_sequences_in_linear_memory():
     assert int(out[3]) < 1500  # MB; 317 MB measured (benchmarks/README.md)
 
 
+def _move_case(n, instance_seed, tour_seed, tours):
+    """A Euclidean instance for the compiled moves' tests: its matrix, neighbour lists and their costs, a
+    plain re-pricing loop (the oracle), and ``tours`` random tours, each with its positions and an empty log,
+    drawn one at a time (a test changes each tour before the next is drawn)."""
+    from htetro_opt.solvers.sequencing import _ils
+
+    C = euclidean(n, instance_seed)
+    nbr = _ils._neighbour_lists(C, 8)
+    rng = np.random.default_rng(tour_seed)
+
+    def loop_cost(tour):
+        return sum(C[tour[i], tour[(i + 1) % n]] for i in range(n))
+
+    def random_tours():
+        for _ in range(tours):
+            tour = rng.permutation(n).astype(np.int64)
+            pos = np.empty(n, dtype=np.int64)
+            pos[tour] = np.arange(n)
+            yield tour, pos, np.empty((4 * n + 64, 4), dtype=np.int64)
+
+    return C, nbr, _ils._neighbour_costs(C, nbr), loop_cost, random_tours()
+
+
 def test_the_lk_move_gains_what_a_repricing_loop_says_and_keeps_a_tour():
     """The LK-style move (2-opt and sequential 3-opt priced without flips, deeper chains flipped and
     undone): on random tours of a Euclidean instance, the gain it reports is the fall of the tour's cost
@@ -187,20 +210,9 @@ def test_the_lk_move_gains_what_a_repricing_loop_says_and_keeps_a_tour():
     from htetro_opt.solvers.sequencing import _ils
 
     n = 80
-    C = euclidean(n, 21)
-    nbr = _ils._neighbour_lists(C, 8)
-    nc = _ils._neighbour_costs(C, nbr)
-    rng = np.random.default_rng(0)
-
-    def loop_cost(tour):
-        return sum(C[tour[i], tour[(i + 1) % n]] for i in range(n))
-
+    C, nbr, nc, loop_cost, tours = _move_case(n, 21, 0, 20)
     flips = set()
-    for _ in range(20):
-        tour = rng.permutation(n).astype(np.int64)
-        pos = np.empty(n, dtype=np.int64)
-        pos[tour] = np.arange(n)
-        log = np.empty((4 * n + 64, 4), dtype=np.int64)
+    for tour, pos, log in tours:
         touched = np.empty(14, dtype=np.int64)
         added = np.empty((6, 2), dtype=np.int64)
         for t1 in range(n):
@@ -212,8 +224,6 @@ def test_the_lk_move_gains_what_a_repricing_loop_says_and_keeps_a_tour():
                 if gain > 0:
                     flips.add(int(count))
     assert {1, 2} <= flips and max(flips) >= 3
-
-
 
 
 def test_the_lk_move_reaches_the_optimum_and_repeats_by_seed():
@@ -234,6 +244,7 @@ def test_the_lk_move_reaches_the_optimum_and_repeats_by_seed():
     plain, deep = (sequence_waypoints(inst, method="ils", seed=5, kicks=2_000, lk_depth=d) for d in (0, 2))
     assert not np.array_equal(plain.order, deep.order)
 
+
 def test_the_segment_exchange_gains_what_a_repricing_loop_says_and_undoes_exactly():
     """The or-3opt move (:func:`_or3_move`, ``or3opt``): on random tours of a Euclidean instance its gain is
     the fall of the tour's cost re-priced by a plain loop, the tour stays a permutation with consistent
@@ -242,20 +253,9 @@ def test_the_segment_exchange_gains_what_a_repricing_loop_says_and_undoes_exactl
     from htetro_opt.solvers.sequencing import _ils
 
     n = 90
-    C = euclidean(n, 22)
-    nbr = _ils._neighbour_lists(C, 8)
-    nc = _ils._neighbour_costs(C, nbr)
-    rng = np.random.default_rng(1)
-
-    def loop_cost(tour):
-        return sum(C[tour[i], tour[(i + 1) % n]] for i in range(n))
-
+    C, nbr, nc, loop_cost, tours = _move_case(n, 22, 1, 12)
     flips = set()
-    for _ in range(12):
-        tour = rng.permutation(n).astype(np.int64)
-        pos = np.empty(n, dtype=np.int64)
-        pos[tour] = np.arange(n)
-        log = np.empty((4 * n + 64, 4), dtype=np.int64)
+    for tour, pos, log in tours:
         touched = np.empty(8, dtype=np.int64)
         for t1 in range(n):
             for back in (0, 1):
