@@ -32,7 +32,8 @@ __all__ = ["JOBS", "warm_up"]
 JOBS = {
     "plan": (["plan", "three_slit", "--json"], ["plan", "three_slit", "--diagonals", "--json"],
              ["plan", "three_slit", "--method", "htetro-ga", "--pop-size", "8", "--max-gen", "2", "--json"]),
-    "sequence": (["sequence", "tiling_11x11", "--method", "ils", "--json"],),
+    "sequence": (["sequence", "tiling_11x11", "--method", "ils", "--json"],
+                 ["sequence", "tiling_11x11", "--method", "ils", "--candidates", "alpha", "--json"]),
 }
 """Each part of the warm-up: the command lines it runs (small, fixed: seconds once kernels are cached)."""
 

@@ -45,5 +45,5 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "solve_zigzag": "._baselines", "solve_spiral": "._baselines", "solve_greedy": "._baselines",
     "PATTERN_VARIANTS": "._baselines",
     "solve_ils": "._ils", "ils_kicks": "._ils", "ILS_NEIGHBOURS": "._spec", "ILS_KICK_SPAN": "._ils",
-    "solve_fast_tsp": "._backends", "solve_lkh": "._backends", "FAST_TSP_CANDIDATES": "._spec",
+    "solve_fast_tsp": "._backends", "solve_lkh": "._backends", "CANDIDATE_LISTS": "._spec",
 })

@@ -42,7 +42,7 @@ from htetro_opt._validation import check_int, check_seed, check_time_limit
 from htetro_opt.errors import ParameterError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance
 from htetro_opt.solvers.sequencing._budgets import default_time_limit
-from htetro_opt.solvers.sequencing._spec import FAST_TSP_CANDIDATES
+from htetro_opt.solvers.sequencing._spec import CANDIDATE_LISTS
 
 __all__ = ["FAST_TSP_RESOLUTION", "LKH_RESOLUTION", "solve_fast_tsp", "solve_lkh"]
 
@@ -153,7 +153,7 @@ def solve_fast_tsp(instance: SequencingInstance, *, seed=0, time_limit: float | 
     threads : int
         fast-tsp's ``max_threads`` (default 1; it never uses more than the machine's cores).
     candidates : str
-        fast-tsp's neighbour lists, one of :data:`FAST_TSP_CANDIDATES`: ``"auto"`` (its default)
+        fast-tsp's neighbour lists, one of :data:`CANDIDATE_LISTS`: ``"auto"`` (its default)
         runs LKH-style α-nearness preprocessing when it fits the budget.
 
     Returns
@@ -179,8 +179,8 @@ def solve_fast_tsp(instance: SequencingInstance, *, seed=0, time_limit: float | 
     limit = check_time_limit(time_limit)
     limit = default_time_limit("fast-tsp", instance.n) if limit is None else limit
     threads = check_int(threads, "threads", minimum=1)
-    if candidates not in FAST_TSP_CANDIDATES:
-        raise ParameterError(f"candidates must be one of {', '.join(FAST_TSP_CANDIDATES)}, got {candidates!r}")
+    if candidates not in CANDIDATE_LISTS:
+        raise ParameterError(f"candidates must be one of {', '.join(CANDIDATE_LISTS)}, got {candidates!r}")
     if not instance.symmetric:
         raise ParameterError("method 'fast-tsp' assumes a symmetric cost matrix, and this one is not: use lkh, "
                              "exact or ortools")

@@ -23,7 +23,9 @@ Stützle 2003):
   k-d tree query (eq. 2 is at least Σw times the centres' distance), or by the TSPLIB metric among the
   ``4k`` nearest coordinates (GEO: points on the unit sphere); ties go to the lowest index, with the
   matrix and without, so both give the same lists. Each node's legs to its neighbours are priced once
-  per run.
+  per run. With ``candidates="alpha"`` (a choice of ours, the default up to :data:`ILS_ALPHA_AUTO`
+  waypoints): each node's alpha-nearest instead (Helsgaun 2000, LKH's candidate sets, section
+  "alpha-nearness candidates" below), still ordered by cost.
 - **Start**: the nearest-neighbour tour from node 0 (dense; a TSPLIB coordinate instance builds the same
   tour with a k-d tree, from its start on an open path), or the waypoints along a Hilbert curve through
   their block centres (implicit eq. 2: nearest neighbour needs every row of the matrix).
@@ -70,8 +72,9 @@ from htetro_opt._validation import as_rng, check_bool, check_int, check_real, ch
 from htetro_opt.errors import ParameterError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance, eq2_legs
 from htetro_opt.solvers.sequencing._budgets import default_time_limit
-from htetro_opt.solvers.sequencing._spec import (ILS_ACCEPT_WORSE, ILS_KICK_RATE, ILS_KICK_SPAN, ILS_LK_DEPTH,
-                                                  ILS_NEIGHBOURS, ILS_OR3OPT)
+from htetro_opt.solvers.sequencing._spec import (CANDIDATE_LISTS, ILS_ACCEPT_WORSE, ILS_ALPHA_AUTO, ILS_ALPHA_LIMIT,
+                                                  ILS_ALPHA_PAIR_SECONDS, ILS_ALPHA_TREES, ILS_KICK_RATE,
+                                                  ILS_KICK_SPAN, ILS_LK_DEPTH, ILS_NEIGHBOURS, ILS_OR3OPT)
 
 __all__ = ["ILS_KICK_SPAN", "LocalCore", "ils_kicks", "solve_ils"]
 
@@ -755,6 +758,327 @@ def _ils(cm, nbr, tour, kicks, span, seed, eps, halt, lk, or3, worse):
     return done, kept
 
 
+# ---------------------------------------------------------------------- alpha-nearness candidates
+# Helsgaun 2000 (LKH), sections 4.1-4.2: a node's candidates are the nodes whose edge to it is nearest to
+# being in a minimum 1-tree, with the node penalties pi of a subgradient ascent on the Held-Karp bound.
+# None of the field's libraries computes them for a cost function given as a kernel (scipy's
+# minimum_spanning_tree takes a matrix or a sparse graph, and the ascent needs hundreds of 1-trees with
+# their special leaf), so they are here, compiled beside the costs they read.
+_ALPHA_NEAREST = 10
+"""Each node's nearest legs in the ascent's sparse graph (with two spanning trees of all the legs)."""
+
+
+@_jit
+def _heap_push(keys, vals, size, key, val):
+    """Push (key, val) on the binary min-heap ``keys[:size]``, ``vals[:size]``: the new size."""
+    i = size
+    keys[i], vals[i] = key, val
+    while i > 0:
+        up = (i - 1) // 2
+        if keys[up] <= keys[i]:
+            break
+        keys[up], keys[i] = keys[i], keys[up]
+        vals[up], vals[i] = vals[i], vals[up]
+        i = up
+    return size + 1
+
+
+@_jit
+def _heap_pop(keys, vals, size):
+    """Pop the least (key, val) of the heap: (key, val, the new size)."""
+    key, val = keys[0], vals[0]
+    size -= 1
+    keys[0], vals[0] = keys[size], vals[size]
+    i = 0
+    while True:
+        low = i
+        for child in (2 * i + 1, 2 * i + 2):
+            if child < size and keys[child] < keys[low]:
+                low = child
+        if low == i:
+            break
+        keys[low], keys[i] = keys[i], keys[low]
+        vals[low], vals[i] = vals[i], vals[low]
+        i = low
+    return key, val, size
+
+
+@_jit
+def _row(cm, v, out):
+    """``out[u]``: the leg ``v → u`` for every node ``u`` (the one part of the alpha lists compiled for each
+    kind of costs; the rest, :func:`_prim_step` and :func:`_alpha_row`, once for all)."""
+    for u in range(out.shape[0]):
+        out[u] = _d(cm, v, u)
+
+
+@_jit
+def _prim_step(row, v, pi, avoid, key, parent, done):
+    """Prim's step at the node ``v`` just joined (``row``: its legs): the keys of the others lowered, the
+    next node to join returned (the legs (u, avoid[u]) left out)."""
+    done[v] = True
+    nxt, low = -1, np.inf
+    for u in range(row.shape[0]):
+        if done[u]:
+            continue
+        c = np.inf if (avoid[u] == v or avoid[v] == u) else row[u] + pi[v] + pi[u]
+        if c < key[u]:
+            key[u], parent[u] = c, v
+        if key[u] < low:
+            low, nxt = key[u], u
+    return nxt
+
+
+@_jit
+def _dense_tree(cm, m, avoid, pi):
+    """The parents of a minimum spanning tree over all ``m`` nodes under the penalties ``pi`` without the
+    tree edges (v, avoid[v]) (Prim, O(m²) look-ups, node 0 the root; ``avoid`` all -1: none left out)."""
+    key = np.full(m, np.inf)
+    parent = np.full(m, -1, dtype=np.int64)
+    done = np.zeros(m, dtype=np.bool_)
+    row = np.empty(m)
+    v = 0
+    for _ in range(m - 1):
+        _row(cm, v, row)
+        v = _prim_step(row, v, pi, avoid, key, parent, done)
+    return parent
+
+
+@_jit
+def _one_tree(ptr, adj, cost, pi, parent, degree, key, done, hk, hv):
+    """A minimum 1-tree of the sparse graph (``ptr``, ``adj``, ``cost``: rows of a symmetric CSR) under the
+    penalties ``pi`` (legs ``cost + pi[a] + pi[b]``): a minimum spanning tree (Prim from node 0, a lazy
+    heap) and the second cheapest edge of the leaf where that edge is dearest (LKH's choice of the special
+    node). Its length, ``parent`` and ``degree`` filled in."""
+    m = ptr.shape[0] - 1
+    key[:] = np.inf
+    done[:] = False
+    parent[:] = -1
+    degree[:] = 0
+    key[0] = 0.0
+    size = _heap_push(hk, hv, 0, 0.0, 0)
+    total = 0.0
+    while size > 0:
+        kv, v, size = _heap_pop(hk, hv, size)
+        if done[v] or kv > key[v]:
+            continue
+        done[v] = True
+        total += kv
+        if parent[v] >= 0:
+            degree[parent[v]] += 1
+            degree[v] += 1
+        for e in range(ptr[v], ptr[v + 1]):
+            u = adj[e]
+            if done[u]:
+                continue
+            c = cost[e] + pi[v] + pi[u]
+            if c < key[u]:
+                key[u], parent[u] = c, v
+                size = _heap_push(hk, hv, size, c, u)
+    root_child = -1
+    for u in range(m):
+        if parent[u] == 0:
+            root_child = u
+            break
+    best, ba, bb = -np.inf, -1, -1
+    for v in range(m):
+        if degree[v] != 1:
+            continue
+        partner = parent[v] if parent[v] >= 0 else root_child
+        second, other = np.inf, -1
+        for e in range(ptr[v], ptr[v + 1]):
+            u = adj[e]
+            c = cost[e] + pi[v] + pi[u]
+            if u != partner and c < second:
+                second, other = c, u
+        if other >= 0 and second > best:
+            best, ba, bb = second, v, other
+    if ba >= 0:
+        total += best
+        degree[ba] += 1
+        degree[bb] += 1
+    return total
+
+
+@_jit
+def _ascent(ptr, adj, cost, upper, max_trees):
+    """A subgradient ascent on the Held-Karp bound (Held and Karp 1970) over the sparse graph: the node
+    penalties ``pi`` of the longest penalised 1-tree (its length less twice the penalties) in at most
+    ``max_trees`` 1-trees, that length and the 1-trees computed.
+
+    The step is Held, Wolfe and Crowder's (1974), ``lam · (upper - w) / |g|²`` along ``g``, LKH's blend
+    ``0.7 (degree - 2) + 0.3 g_previous`` of the degrees (Helsgaun 2000, section 4.1), ``upper`` a tour's
+    length, ``lam`` from 1 halved after 10 trees without a longer one. LKH's own schedule (a step doubled
+    while it gains, halved each period) is a choice of ours left out: on the complete graphs of rd400 and
+    pcb442 it ended 4.3 % and 4.6 % below the optimum after 300 trees, this one 0.82 % and 0.58 %
+    (converged: 0.82 % and 0.56-0.61 % after 1000 trees, both)."""
+    m = ptr.shape[0] - 1
+    nnz = ptr[m]
+    pi = np.zeros(m)
+    best_pi = np.zeros(m)
+    g = np.zeros(m)
+    parent = np.empty(m, dtype=np.int64)
+    degree = np.empty(m, dtype=np.int64)
+    key = np.empty(m)
+    done = np.empty(m, dtype=np.bool_)
+    hk = np.empty(nnz + 1)
+    hv = np.empty(nnz + 1, dtype=np.int64)
+    lam, best_w, stalled, trees = 1.0, -np.inf, 0, 0
+    while trees < max_trees and lam > 1e-6:
+        w = _one_tree(ptr, adj, cost, pi, parent, degree, key, done, hk, hv) - 2.0 * pi.sum()
+        trees += 1
+        if w > best_w:
+            best_w, stalled = w, 0
+            best_pi[:] = pi
+        else:
+            stalled += 1
+            if stalled == 10:
+                lam, stalled = 0.5 * lam, 0
+        off, norm = 0, 0.0
+        for i in range(m):
+            off += abs(degree[i] - 2)
+            g[i] = 0.7 * (degree[i] - 2) + 0.3 * g[i]
+            norm += g[i] * g[i]
+        if off == 0 or norm == 0.0 or upper <= w:  # a tour (its length the bound, the best there is) or upper met
+            break
+        t = lam * (upper - w) / norm
+        for i in range(m):
+            pi[i] += t * g[i]
+    return best_pi, best_w, trees
+
+
+@_jit
+def _tree_order(parent):
+    """The nodes of the tree ``parent`` (-1 at its root) parents first: a breadth-first order from the root."""
+    m = parent.shape[0]
+    children = np.zeros(m + 1, dtype=np.int64)
+    root = 0
+    for v in range(m):
+        if parent[v] >= 0:
+            children[parent[v] + 1] += 1
+        else:
+            root = v
+    for v in range(m):
+        children[v + 1] += children[v]
+    fill = children[:m].copy()
+    kids = np.empty(max(m - 1, 1), dtype=np.int64)
+    for v in range(m):
+        if parent[v] >= 0:
+            kids[fill[parent[v]]] = v
+            fill[parent[v]] += 1
+    order = np.empty(m, dtype=np.int64)
+    order[0] = root
+    tail = 1
+    for h in range(m):
+        v = order[h]
+        for e in range(children[v], children[v + 1]):
+            order[tail] = kids[e]
+            tail += 1
+    return order
+
+
+@_jit
+def _alpha_row(row, i, pi, parent, order, up, beta, mark, out):
+    """Node ``i``'s ``len(out)`` alpha-nearest others (``row``: its legs; ``up``: each node's penalised leg to
+    its tree parent), written to ``out`` cheapest leg first. alpha(i, j) = c'(i, j) minus the dearest leg
+    on the tree path between i and j (Helsgaun 2000, section 4.2), the ``beta`` of j: up the path from i to
+    the root, then down from each node's parent in ``order``. The k least by (alpha, c'), then ordered by
+    the leg's own cost (ties by index), so that the local search may stop a scan at the first leg that
+    leaves no gain."""
+    m, k = row.shape[0], out.shape[0]
+    beta[i] = -np.inf
+    mark[i] = i
+    u = i
+    while parent[u] >= 0:
+        p = parent[u]
+        beta[p] = max(beta[u], up[u])
+        mark[p] = i
+        u = p
+    for h in range(1, m):
+        v = order[h]
+        if mark[v] != i:
+            beta[v] = max(beta[parent[v]], up[v])
+    ba = np.empty(k)
+    bc = np.empty(k)
+    bj = np.empty(k, dtype=np.int64)
+    size = 0
+    for j in range(m):
+        if j == i:
+            continue
+        c = row[j] + pi[i] + pi[j]
+        a = c - beta[j]
+        if size == k and (a > ba[k - 1] or (a == ba[k - 1] and c >= bc[k - 1])):
+            continue
+        t = size if size < k else k - 1
+        while t > 0 and (a < ba[t - 1] or (a == ba[t - 1] and c < bc[t - 1])):
+            ba[t], bc[t], bj[t] = ba[t - 1], bc[t - 1], bj[t - 1]
+            t -= 1
+        ba[t], bc[t], bj[t] = a, c, j
+        if size < k:
+            size += 1
+    for t in range(size):  # by the leg's own cost (an insertion sort of k), ties by index
+        bc[t] = row[bj[t]]
+    for t in range(1, size):
+        cj, jj = bc[t], bj[t]
+        q = t
+        while q > 0 and (bc[q - 1] > cj or (bc[q - 1] == cj and bj[q - 1] > jj)):
+            bc[q], bj[q] = bc[q - 1], bj[q - 1]
+            q -= 1
+        bc[q], bj[q] = cj, jj
+    out[:] = bj
+
+
+@_jit
+def _alpha_lists(cm, pi, parent, k):
+    """Each node's ``k`` alpha-nearest other nodes (:func:`_alpha_row`) for the spanning tree ``parent``
+    under the penalties ``pi``: O(m²) look-ups, O(m) memory."""
+    m = pi.shape[0]
+    order = _tree_order(parent)
+    up = np.full(m, -np.inf)  # the leg from each node to its parent, under pi
+    for v in range(m):
+        if parent[v] >= 0:
+            up[v] = _d(cm, v, parent[v]) + pi[v] + pi[parent[v]]
+    beta = np.empty(m)
+    mark = np.full(m, -1, dtype=np.int64)
+    row = np.empty(m)
+    out = np.empty((m, k), dtype=np.int64)
+    for i in range(m):
+        _row(cm, i, row)
+        _alpha_row(row, i, pi, parent, order, up, beta, mark, out[i])
+    return out
+
+
+def _alpha_neighbour_lists(cm, m: int, near: np.ndarray, k: int, upper: float,
+                           max_trees: int = ILS_ALPHA_TREES) -> tuple[np.ndarray, int]:
+    """Each node's ``k`` alpha-nearest other nodes, cheapest first, and the 1-trees the ascent computed
+    (``upper``: a tour's length, for the ascent's step).
+
+    The penalties come from :func:`_ascent` on a sparse graph, the lists ``near`` and two edge-disjoint
+    minimum spanning trees of all the legs, both ways (connected, and with a second choice at every node,
+    on clustered instances too); the alpha values from the minimum spanning tree of *all* the legs under
+    those penalties, so that every leg's alpha is at least 0 and the tree's own legs' exactly 0. The
+    ascent's bound is not returned: on the sparse graph it is no lower bound of the tour (fl1577: 23142,
+    above the optimum 22249)."""
+    none, flat = np.full(m, -1, dtype=np.int64), np.zeros(m)
+    first = _dense_tree(cm, m, none, flat)
+    second = _dense_tree(cm, m, first, flat)
+    a = [np.repeat(np.arange(m), near.shape[1])]
+    b = [near.ravel()]
+    for parent in (first, second):
+        child = np.flatnonzero(parent >= 0)
+        a.append(child)
+        b.append(parent[child])
+    a, b = np.concatenate(a), np.concatenate(b)
+    pairs = np.unique(np.minimum(a, b) * m + np.maximum(a, b))
+    lo, hi = pairs // m, pairs % m
+    rows, cols = np.concatenate([lo, hi]), np.concatenate([hi, lo])
+    order = np.lexsort((cols, rows))
+    rows, cols = rows[order], cols[order]
+    ptr = np.zeros(m + 1, dtype=np.int64)
+    np.cumsum(np.bincount(rows, minlength=m), out=ptr[1:])
+    pi, _, trees = _ascent(ptr, cols, _legs(cm, rows, cols), upper, max_trees)
+    return _alpha_lists(cm, pi, _dense_tree(cm, m, none, pi), min(k, m - 1)), int(trees)
+
+
 # ------------------------------------------------------------------------------------- the method
 def _cost_model(instance: SequencingInstance) -> tuple[tuple, int, int | None, float]:
     """The closed, symmetric tour the kernel solves (module docstring): ``(cm, m, dummy, top)``.
@@ -1006,7 +1330,7 @@ def _costs_kind(instance) -> str:
 def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int | None = None,
               neighbours: int = ILS_NEIGHBOURS, lk_depth: int = ILS_LK_DEPTH, or3opt: bool = ILS_OR3OPT,
               kick_rate: float = ILS_KICK_RATE, accept_worse: float = ILS_ACCEPT_WORSE,
-              kick_span: int = ILS_KICK_SPAN) -> tuple[np.ndarray, dict]:
+              kick_span: int = ILS_KICK_SPAN, candidates: str = "auto") -> tuple[np.ndarray, dict]:
     """Iterated local search (2-opt + Or-opt, local double-bridge kicks), compiled and seeded.
 
     Parameters
@@ -1041,20 +1365,29 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     kick_span : int
         Longest segment of a kick's double bridge (:data:`ILS_KICK_SPAN`; ``n // 4`` or more: a global
         double bridge).
+    candidates : {"auto", "nearest", "alpha"}
+        The neighbour lists: ``"nearest"``, each node's cheapest legs; ``"alpha"``, each node's
+        alpha-nearest (Helsgaun 2000, section 4: a leg's alpha is how much longer the cheapest 1-tree
+        containing it is, under the penalties of at most :data:`ILS_ALPHA_TREES` steps of a subgradient
+        ascent), ordered by cost, O(n²) leg look-ups, at most :data:`ILS_ALPHA_LIMIT` waypoints;
+        ``"auto"``: alpha up to :data:`ILS_ALPHA_AUTO` waypoints when their estimated cost
+        (:data:`ILS_ALPHA_PAIR_SECONDS`) is at most a tenth of the time limit, nearest otherwise.
 
     Returns
     -------
     order : ndarray of int64
     info : dict
         ``engine`` (``"numba"``, or ``"enumeration"`` below 8 nodes), ``costs`` (``"matrix"`` or
-        implicit), ``kicks`` (done), ``improving_kicks``, ``timed_out``, ``initial_cost`` (the start
-        tour, on the closed tour), ``tour_cost``.
+        implicit), ``candidates`` (``"nearest"``, ``"alpha"``, or ``"none"`` for the enumeration),
+        ``ascent_trees`` (the 1-trees of alpha's ascent, 0 without), ``kicks`` (done),
+        ``improving_kicks``, ``timed_out``, ``initial_cost`` (the start tour, on the closed tour),
+        ``tour_cost``.
 
     Raises
     ------
     ParameterError
-        On an asymmetric instance, a negative ``kicks``, ``neighbours < 1`` or an invalid seed or
-        time limit.
+        On an asymmetric instance, a negative ``kicks``, ``neighbours < 1``, an unknown ``candidates``
+        (or alpha lists beyond :data:`ILS_ALPHA_LIMIT` waypoints) or an invalid seed or time limit.
 
     Examples
     --------
@@ -1078,6 +1411,14 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     kick_span = check_int(kick_span, "kick_span", minimum=1)
     or3opt = check_bool(or3opt, "or3opt")
     neighbours = check_int(neighbours, "neighbours", minimum=1)
+    if candidates not in CANDIDATE_LISTS:
+        raise ParameterError(f"candidates must be one of {', '.join(CANDIDATE_LISTS)}, got {candidates!r}")
+    # auto: alpha where it pays at no risk to the time limit (a rule of the arguments, so reproducible)
+    alpha = candidates == "alpha" or (candidates == "auto" and instance.n <= ILS_ALPHA_AUTO
+                                      and instance.n ** 2 * ILS_ALPHA_PAIR_SECONDS <= 0.1 * time_limit)
+    if alpha and instance.n > ILS_ALPHA_LIMIT:
+        raise ParameterError(f"candidates='alpha' costs O(n²) leg look-ups: at most {ILS_ALPHA_LIMIT} waypoints, "
+                             f"got {instance.n}; use candidates='nearest'")
     rng = as_rng(seed)
     stream = int(rng.integers(0, 2**63))
     began = time.perf_counter()
@@ -1095,20 +1436,25 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
         best = tours[int(np.argmin(costs))]
         cost = float(costs.min())
         return _decode(best, dummy, instance), {"engine": "enumeration", "costs": _costs_kind(instance),
-                                                "initial_cost": cost, "kicks": 0,
-                                                "improving_kicks": 0, "timed_out": False, "tour_cost": cost}
+                                                "candidates": "none", "ascent_trees": 0, "initial_cost": cost,
+                                                "kicks": 0, "improving_kicks": 0, "timed_out": False,
+                                                "tour_cost": cost}
+    # alpha: its lists among the nearest ALPHA_NEAREST and two spanning trees (the ascent's sparse graph)
+    near = max(neighbours, _ALPHA_NEAREST) if alpha else neighbours
     if instance.implicit:
-        nbr = _implicit_neighbour_lists(cm, dummy, neighbours)
+        nbr = _implicit_neighbour_lists(cm, dummy, near)
         first = 0 if instance.start is None else instance.start
         if instance.coords is not None:  # (a closed tour: the dense matrix's start tour, from node 0 as it)
             tour = _nearest_neighbour_tour(cm, dummy, 0 if dummy is None else first)
         else:
             tour = _hilbert_tour(cm, dummy, first)
     else:
-        nbr = _neighbour_lists(cm, neighbours)
+        nbr = _neighbour_lists(cm, near)
         tour = _greedy_tour(cm).astype(np.int64)
-    info = {"engine": "numba", "costs": _costs_kind(instance),
-            "initial_cost": float(_tour_cost(cm, tour))}
+    info = {"engine": "numba", "costs": _costs_kind(instance), "candidates": "alpha" if alpha else "nearest",
+            "ascent_trees": 0, "initial_cost": float(_tour_cost(cm, tour))}
+    if alpha:
+        nbr, info["ascent_trees"] = _alpha_neighbour_lists(cm, m, nbr, neighbours, info["initial_cost"])
     eps = 1e-9 * max(1.0, top)
     done = kept = 0
     timed_out = False

@@ -19,9 +19,10 @@ from htetro_opt.errors import ParameterError
 from htetro_opt.solvers.sequencing._budgets import TIME_LIMIT_TEXT
 from htetro_opt.solvers.tiling._spec import shape_letters  # a scenario is tiled first: its shapes are the tiler's
 
-__all__ = ["SPEC", "is_tileset", "GA_ADDITIONS", "EXACT_AUTO_LIMIT", "EXACT_MAX_SIZE", "EXACT_TIME_LIMIT", "FAST_TSP_CANDIDATES",
-           "FIRST_SOLUTIONS", "ILS_ACCEPT_WORSE", "ILS_KICK_RATE", "ILS_KICK_SPAN", "ILS_LK_DEPTH", "ILS_NEIGHBOURS",
-           "ILS_OR3OPT"]
+__all__ = ["SPEC", "is_tileset", "GA_ADDITIONS", "CANDIDATE_LISTS", "EXACT_AUTO_LIMIT", "EXACT_MAX_SIZE",
+           "EXACT_TIME_LIMIT", "FIRST_SOLUTIONS", "ILS_ACCEPT_WORSE", "ILS_ALPHA_AUTO", "ILS_ALPHA_LIMIT",
+           "ILS_ALPHA_PAIR_SECONDS", "ILS_ALPHA_TREES", "ILS_KICK_RATE", "ILS_KICK_SPAN", "ILS_LK_DEPTH",
+           "ILS_NEIGHBOURS", "ILS_OR3OPT"]
 
 EXACT_AUTO_LIMIT = 40
 """``auto`` proves the optimum with the exact solver up to this many waypoints (a closed tour counts
@@ -62,6 +63,30 @@ as much (benchmarks/README.md, issue 25)."""
 ILS_KICK_SPAN = 100
 """Longest segment of a kick's double bridge in ``ils`` (each of its three segments has 1…this many nodes)."""
 
+ILS_ALPHA_TREES = 300
+"""Most 1-trees of the subgradient ascent behind ``ils``'s alpha-nearness lists (``candidates="alpha"``). The
+lists then cost 0.15-0.25 s at 1000-1600 nodes, and hold 99.9 % (pr1002), 99.2 % (fl1577) and 99.4 % (d1291)
+of the edges of fast-tsp's 3 s tours, against 99.5 %, 98.9 % and 97.4 % for the 8 nearest; 1000 trees
+change none of the three (benchmarks/README.md, issue 25)."""
+
+ILS_ALPHA_LIMIT = 20_000
+"""Most waypoints ``ils`` computes alpha-nearness lists for: they cost O(n²) leg look-ups (three minimum
+spanning trees over all the legs, and each node's alpha to every other), 18-22 s at 16 384 TSPLIB coordinates,
+so beyond this the nearest lists are the only ones."""
+
+ILS_ALPHA_AUTO = 5_000
+"""Up to this many waypoints ``ils``'s default lists (``candidates="auto"``) are the alpha-nearness ones, when
+their estimated cost (:data:`ILS_ALPHA_PAIR_SECONDS`) is at most a tenth of the time limit, the nearest
+otherwise (a choice fixed by the arguments, so a run stays reproducible). On 18 TSPLIB instances of 400-2103 cities at
+their kick budget, two seeds: mean gap to the optimum 0.400 % against 0.656 % with the nearest lists (fl1400
+and fl1577, clustered: 0.18 % and 0.35 % against 1.91 % and 3.51 %), better on 9 instances and worse on 9
+(benchmarks/README.md, issue 25)."""
+
+ILS_ALPHA_PAIR_SECONDS = 1.5e-7
+"""The alpha lists' estimated cost, in seconds a pair of waypoints, for ``candidates="auto"``'s choice (the
+time limit's tenth: up to 2582 waypoints at 10 s, 1154 at 2 s): measured 0.15 s at 1002 (1.5e-7 s a pair,
+the ascent included), 0.19-0.22 s at 1291-1577 and 20 s at 16 384 TSPLIB coordinates (0.8e-7)."""
+
 ILS_ACCEPT_WORSE = 0.0
 """How far above its best tour, in mean legs, ``ils`` keeps a kick's result (0: only when no costlier).
 0.05 and 0.3 gave 0.508 % and 0.580 % mean gap on six TSPLIB instances at 200 000 kicks, against 0.484 %."""
@@ -81,8 +106,11 @@ waypoint coordinates, the model is invalid without them), and ``CHRISTOFIDES`` a
 ``BEST_INSERTION``, which with OR-Tools 9.15 end the search early on this model (status
 ``ROUTING_OPTIMAL`` for a path 9 % above the optimum on 12 waypoints)."""
 
-FAST_TSP_CANDIDATES = ("auto", "nearest", "alpha")
-"""fast-tsp's neighbour lists (its ``candidates``): see :func:`~htetro_opt.solvers.sequencing.solve_fast_tsp`."""
+CANDIDATE_LISTS = ("auto", "nearest", "alpha")
+"""The neighbour (candidate) lists of ``ils`` and fast-tsp, the ``candidates`` option: ``nearest``, each node's
+cheapest legs; ``alpha``, alpha-nearness (Helsgaun 2000, LKH); ``auto``, the method's own choice (``ils``:
+alpha up to :data:`ILS_ALPHA_AUTO` waypoints within a tenth of the time limit; fast-tsp: its own, see
+:func:`~htetro_opt.solvers.sequencing.solve_fast_tsp`)."""
 
 
 def _label(value, name):
@@ -182,8 +210,10 @@ OPTIONS = (
            default="PATH_CHEAPEST_ARC", flag="", choices=FIRST_SOLUTIONS),
     Option("max_size", integer(1), "largest instance the exact solver accepts", default=EXACT_MAX_SIZE, flag=""),
     Option("threads", integer(1), "fast-tsp's threads", default=1, flag=""),
-    Option("candidates", choice(FAST_TSP_CANDIDATES), "fast-tsp's neighbour lists", default="auto", flag="",
-           choices=FAST_TSP_CANDIDATES),
+    Option("candidates", choice(CANDIDATE_LISTS), "neighbour lists: nearest (the cheapest legs), alpha "
+           "(alpha-nearness, Helsgaun 2000) or auto, the method's own (ils: alpha up to "
+           f"{ILS_ALPHA_AUTO} waypoints when they fit a tenth of the time limit, nearest otherwise)", default="auto",
+           choices=CANDIDATE_LISTS),
     Option("runs", integer(1), "LKH's independent runs, the best kept", default=1, type=int, metavar="N"),
 )
 
@@ -197,10 +227,10 @@ METHODS = (
     # auto runs exact, ils or ortools (auto_method): it takes their options and hands each the ones it takes
     Method("auto", None, f"exact up to {EXACT_AUTO_LIMIT} waypoints, ils beyond (ortools for asymmetric costs)",
            ("seed", "time_limit", "progress", "max_size", "kicks", "neighbours", "lk_depth", "or3opt",
-            "kick_rate", "accept_worse", "kick_span", "scale",
+            "kick_rate", "accept_worse", "kick_span", "candidates", "scale",
             "first_solution",
             "solution_limit"),
-           seeded=True, capabilities={"asymmetric", "tours", "implicit"}),
+           seeded=True, capabilities={"asymmetric", "tours", "implicit"}, revision=2),  # 2: ils's alpha lists
     Method("exact", "._exact:solve_exact", f"the CP-SAT optimum with a proof (<= {EXACT_MAX_SIZE} waypoints)",
            ("time_limit", "max_size"), exact=True, origin="reference", capabilities={"asymmetric"}),
     Method("ortools", "._ortools:solve_ortools", "OR-Tools routing with guided local search (the paper's baseline)",
@@ -211,8 +241,8 @@ METHODS = (
            seeded=lambda options: options.get("restarts", 0) > 0, capabilities={"progress"}),
     Method("ils", "._ils:solve_ils", "the compiled, seeded iterated local search (2-opt, Or-opt, double-bridge "
            "kicks)", ("seed", "time_limit", "kicks", "neighbours", "lk_depth", "or3opt", "kick_rate",
-           "accept_worse", "kick_span"), seeded=True,
-           capabilities={"tours", "implicit"}),
+           "accept_worse", "kick_span", "candidates"), seeded=True,
+           capabilities={"tours", "implicit"}, revision=2),  # 2: the alpha-nearness lists by default
     Method("ga", "._ga:solve_ga", "the paper's GA on DEAP with our additions (order crossover, distinct "
            "survivors, a 2-opt/Or-opt step)", _GA, defaults={"additions": tuple(GA_ADDITIONS), "patience": 50},
            seeded=True, origin="ours", paper=_PAPER, family=("ga",), capabilities={"progress"}),

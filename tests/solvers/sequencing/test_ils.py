@@ -67,7 +67,8 @@ def test_same_seed_same_order_and_the_budget_is_kicks():
     b = sequence_waypoints(inst, method="ils", seed=5, kicks=20_000)
     c = sequence_waypoints(inst, method="ils", seed=6, kicks=20_000)
     assert np.array_equal(a.order, b.order) and a.info["kicks"] == 20_000 and not a.info["timed_out"]
-    assert not np.array_equal(a.order, c.order)  # another seed, another walk (and here another tour)
+    # another seed, another walk (with the alpha lists both walks end at the same tour here)
+    assert (a.info["improving_kicks"], a.order.tolist()) != (c.info["improving_kicks"], c.order.tolist())
     assert ils_kicks(300) > 20_000
 
 
@@ -277,10 +278,10 @@ def test_the_segment_exchange_gains_what_a_repricing_loop_says_and_undoes_exactl
 
 
 @pytest.mark.parametrize("options", [{"or3opt": True}, {"accept_worse": 0.2}, {"kick_span": 10},
-                                     {"or3opt": True, "lk_depth": 2, "kick_span": 7}])
+                                     {"or3opt": True, "lk_depth": 2, "kick_span": 7}, {"candidates": "nearest"}])
 def test_the_search_options_keep_a_valid_tour_priced_right_and_repeat_by_seed(options):
-    """``or3opt``, ``accept_worse`` and ``kick_span`` (off or at their defaults in ``ILS_*``): the same seed
-    gives the same tour when the kicks complete, the reported cost is the re-priced tour's, no tour is
+    """``or3opt``, ``accept_worse``, ``kick_span`` and ``candidates`` (off or at their defaults in ``ILS_*``):
+    the same seed gives the same tour when the kicks complete, the reported cost is the re-priced tour's, no tour is
     below the proven optimum of berlin52 (7542, TSPLIB) and each option reaches the kernel (another walk
     than the default's on 300 nodes)."""
     from pathlib import Path
@@ -315,8 +316,88 @@ def test_an_explicit_time_limit_sets_a_kick_budget_that_repeats_when_it_complete
     assert sequence_waypoints(inst, method="ils", seed=2, time_limit=1, kick_rate=10).info["kicks"] == ils_kicks(60)
 
 
-@pytest.mark.parametrize("bad", [{"kick_rate": -1.0}, {"accept_worse": -0.5}, {"kick_span": 0}, {"or3opt": "yes"}])
+@pytest.mark.parametrize("bad", [{"kick_rate": -1.0}, {"accept_worse": -0.5}, {"kick_span": 0}, {"or3opt": "yes"},
+                                 {"candidates": "quadrant"}])
 def test_bad_search_options_are_refused_before_work(bad):
     inst = SequencingInstance.from_matrix(euclidean(30, 1), closed=True)
     with pytest.raises(ParameterError, match=next(iter(bad))):
         sequence_waypoints(inst, method="ils", **bad)
+
+
+def test_alpha_lists_match_a_spanning_tree_oracle():
+    """``candidates="alpha"``'s lists (Helsgaun 2000, section 4.2), for any penalties: each node's k others
+    of least alpha (the leg under the penalties less the dearest leg on the minimum spanning tree's path
+    between its ends), ordered by cost. The oracle: scipy's minimum spanning tree of the penalised matrix
+    and each tree path walked in Python."""
+    from scipy.sparse.csgraph import minimum_spanning_tree
+
+    from htetro_opt.solvers.sequencing._ils import _alpha_lists, _dense_tree
+
+    m, k = 40, 6
+    C = euclidean(m, 11)
+    pi = np.random.default_rng(12).normal(0.0, 3.0, m)
+    P = C + pi[:, None] + pi[None, :]
+    parent = _dense_tree(C, m, np.full(m, -1), pi)
+    tree = minimum_spanning_tree(P - P.min() + 1.0).toarray()  # (a constant shift keeps every leg positive)
+    ours = {frozenset((v, int(parent[v]))) for v in range(m) if parent[v] >= 0}
+    assert ours == {frozenset(e) for e in zip(*np.nonzero(tree))}
+    adjacent = {v: set() for v in range(m)}
+    for a, b in ours:
+        adjacent[a].add(b)
+        adjacent[b].add(a)
+    lists = _alpha_lists(C, pi, parent, k)
+    for i in range(m):
+        dearest = {i: -np.inf}  # the dearest penalised leg on the tree path from i, by a walk from i
+        stack = [i]
+        while stack:
+            v = stack.pop()
+            for u in adjacent[v] - dearest.keys():
+                dearest[u] = max(dearest[v], P[v, u])
+                stack.append(u)
+        alpha = {j: P[i, j] - dearest[j] for j in range(m) if j != i}
+        assert all(alpha[j] == pytest.approx(0.0, abs=1e-9) for j in adjacent[i])
+        assert min(alpha.values()) >= -1e-9
+        chosen = sorted(alpha, key=lambda j: (alpha[j], P[i, j]))[:k]
+        assert lists[i].tolist() == sorted(chosen, key=lambda j: (C[i, j], j))
+
+
+def test_the_ascent_raises_the_one_tree_bound_and_never_past_the_optimum():
+    """The subgradient ascent behind the alpha lists, on the complete graph of 13 nodes: its penalised
+    1-tree length is a Held-Karp lower bound, so it never exceeds the proven optimum (``held_karp``), and
+    it rises above the plain 1-tree's."""
+    from htetro_opt.solvers.sequencing._ils import _ascent
+
+    m = 13
+    C = euclidean(m, 21)
+    # the closed tour's optimum: the best open path from 0 to a copy of 0 that nothing leaves cheaply
+    open_path = np.full((m + 1, m + 1), 1e6)
+    open_path[:m, :m], open_path[:m, m] = C, C[:, 0]
+    optimum = held_karp(open_path, start=0)[1]
+    rows, cols = np.nonzero(~np.eye(m, dtype=bool))
+    ptr = np.arange(0, m * (m - 1) + 1, m - 1)
+    upper = C[np.arange(m), np.roll(np.arange(m), -1)].sum()  # a tour's length, for the step
+    plain = _ascent(ptr, cols, C[rows, cols], upper, 1)[1]
+    pi, bound, trees = _ascent(ptr, cols, C[rows, cols], upper, 500)
+    assert 1 < trees <= 500 and pi.shape == (m,)
+    assert plain < bound <= optimum + 1e-9
+
+
+def test_the_default_lists_are_alpha_up_to_their_limit_and_nearest_beyond(monkeypatch):
+    """``candidates="auto"``: alpha-nearness lists up to ``ILS_ALPHA_AUTO`` waypoints and within a tenth of the
+    time limit, the nearest otherwise; ``"alpha"`` beyond ``ILS_ALPHA_LIMIT`` is refused before any work (both
+    limits lowered to 59 here, so that 60 waypoints pass them)."""
+    from htetro_opt.solvers.sequencing import _ils
+
+    inst = SequencingInstance.from_matrix(euclidean(60, 7), closed=True)
+    assert sequence_waypoints(inst, method="ils", kicks=10).info["candidates"] == "alpha"
+    assert sequence_waypoints(inst, method="ils", kicks=10, candidates="nearest").info["candidates"] == "nearest"
+    # a time limit whose tenth the estimate (60² pairs at ILS_ALPHA_PAIR_SECONDS) passes: the nearest lists
+    tight = 60 ** 2 * _ils.ILS_ALPHA_PAIR_SECONDS * 10
+    assert sequence_waypoints(inst, method="ils", kicks=10, time_limit=0.9 * tight).info["candidates"] == "nearest"
+    assert sequence_waypoints(inst, method="ils", kicks=10, time_limit=1.1 * tight).info["candidates"] == "alpha"
+    monkeypatch.setattr(_ils, "ILS_ALPHA_AUTO", 59)
+    assert sequence_waypoints(inst, method="ils", kicks=10).info["candidates"] == "nearest"
+    assert sequence_waypoints(inst, method="ils", kicks=10, candidates="alpha").info["candidates"] == "alpha"
+    monkeypatch.setattr(_ils, "ILS_ALPHA_LIMIT", 59)
+    with pytest.raises(ParameterError, match="candidates='alpha'.*at most 59 waypoints, got 60"):
+        sequence_waypoints(inst, method="ils", candidates="alpha")
