@@ -907,10 +907,10 @@ def _ascent(ptr, adj, cost, upper, max_trees):
 
     The step is Held, Wolfe and Crowder's (1974), ``lam · (upper - w) / |g|²`` along ``g``, LKH's blend
     ``0.7 (degree - 2) + 0.3 g_previous`` of the degrees (Helsgaun 2000, section 4.1), ``upper`` a tour's
-    length, ``lam`` from 1 halved after 10 trees without a longer one. LKH's own schedule (a step doubled
-    while it gains, halved each period) is a choice of ours left out: on the complete graphs of rd400 and
-    pcb442 it ended 4.3 % and 4.6 % below the optimum after 300 trees, this one 0.82 % and 0.58 %
-    (converged: 0.82 % and 0.56-0.61 % after 1000 trees, both)."""
+    length, ``lam`` from 1 halved after 10 trees without a longer one. This step in place of LKH's own
+    schedule (a step doubled while it gains, halved each period) is a choice of ours: on the complete graphs
+    of rd400 and pcb442 LKH's schedule ended 4.3 % and 4.6 % below the optimum after 300 trees, this one
+    0.82 % and 0.58 % (converged: 0.82 % and 0.56-0.61 % after 1000 trees, both)."""
     m = ptr.shape[0] - 1
     nnz = ptr[m]
     pi = np.zeros(m)
