@@ -9,7 +9,7 @@ import sys
 import pytest
 
 from htetro_opt.errors import ParameterError
-from htetro_opt.cli.warmup import warm_up
+from htetro_opt.cli.warmup import JOBS, warm_up
 
 
 def test_a_first_warm_up_compiles_and_says_so_a_second_compiles_nothing(tmp_path):
@@ -29,3 +29,16 @@ def test_a_first_warm_up_compiles_and_says_so_a_second_compiles_nothing(tmp_path
 def test_an_unknown_part_is_refused_before_any_work():
     with pytest.raises(ParameterError, match="unknown warm-up part.*'planning'.*plan, sequence"):
         warm_up(["planning"])
+
+
+def test_the_sequence_part_writes_a_tsplib_file_of_coordinates():
+    """The sequence part's TSPLIB job reads a 12-city EUC_2D file (written to a temporary folder when the
+    job runs), posed as a coordinate instance: the kernels of costs computed from coordinates compile too."""
+    from htetro_opt.cli.warmup import _TSPLIB, _WARMUP_TSP
+    from htetro_opt.problems import SequencingInstance
+    from htetro_opt.scenarios.tsplib import parse_tsplib
+
+    assert any(_TSPLIB in args for args in JOBS["sequence"])
+    tsp = parse_tsplib(_WARMUP_TSP)
+    inst = SequencingInstance.from_tsplib(tsp)
+    assert inst.n == 12 and inst.implicit and inst.metric == "EUC_2D"

@@ -12,7 +12,7 @@ the warm-up does the same work ahead, by running small jobs of the commands thro
   and one without diagonal moves, run compiled rather than in the interpreter) and a short hTetro-GA run
   (the simulator's and the operators' kernels);
 - ``sequence``: the compiled iterated local search of the sequencing task (``--method ils``; the longest
-  compile, some 10 s).
+  compile, some 10 s), with both kinds of neighbour lists, on a tileset and on a TSPLIB file.
 
 It prints how many kernels it compiled and how many it loaded from numba's cache: a second warm-up (or
 any later process) compiles none. A small exact plan (a 24 x 24 map) needs none of them: its search runs
@@ -26,16 +26,25 @@ from __future__ import annotations
 import contextlib
 import io
 import sys
+import tempfile
+from pathlib import Path
 
 __all__ = ["JOBS", "warm_up"]
+
+_TSPLIB = "<a 12-city TSPLIB file>"
+_WARMUP_TSP = ("NAME : warmup12\nTYPE : TSP\nDIMENSION : 12\nEDGE_WEIGHT_TYPE : EUC_2D\nNODE_COORD_SECTION\n"
+               + "".join(f"{i + 1} {i * 37 % 11 * 10} {i * 53 % 7 * 10}\n" for i in range(12)) + "EOF\n")
 
 JOBS = {
     "plan": (["plan", "three_slit", "--json"], ["plan", "three_slit", "--diagonals", "--json"],
              ["plan", "three_slit", "--method", "htetro-ga", "--pop-size", "8", "--max-gen", "2", "--json"]),
     "sequence": (["sequence", "tiling_11x11", "--method", "ils", "--json"],
-                 ["sequence", "tiling_11x11", "--method", "ils", "--candidates", "alpha", "--json"]),
+                 ["sequence", "tiling_11x11", "--method", "ils", "--candidates", "alpha", "--json"],
+                 ["sequence", _TSPLIB, "--method", "ils", "--json"]),
 }
-"""Each part of the warm-up: the command lines it runs (small, fixed: seconds once kernels are cached)."""
+"""Each part of the warm-up: the command lines it runs (small, fixed: seconds once kernels are cached;
+``_TSPLIB`` stands for a 12-city TSPLIB file the warm-up writes to a temporary folder, so that the kernels
+of TSPLIB coordinate instances, costs computed from the coordinates, compile too)."""
 
 
 def warm_up(parts=tuple(JOBS), *, say=None) -> dict[str, int]:
@@ -73,7 +82,11 @@ def warm_up(parts=tuple(JOBS), *, say=None) -> dict[str, int]:
     try:
         for part in parts:
             for args in JOBS[part]:
-                with contextlib.redirect_stdout(io.StringIO()):
+                with tempfile.TemporaryDirectory() as folder, contextlib.redirect_stdout(io.StringIO()):
+                    if _TSPLIB in args:
+                        path = Path(folder) / "warmup12.tsp"
+                        path.write_text(_WARMUP_TSP)
+                        args = [str(path) if a == _TSPLIB else a for a in args]
                     code = main(args)
                 if code != 0:
                     raise HtetroError(f"the warm-up job 'htetro-opt {' '.join(args)}' failed (exit status {code})")
