@@ -80,18 +80,19 @@ def warm_up(parts=tuple(JOBS), *, say=None) -> dict[str, int]:
     sweep_tables(0.0)
     left, _lazy._interpreted_left = _lazy._interpreted_left, 0  # the compiled searches, not the interpreter's
     try:
-        for part in parts:
-            for args in JOBS[part]:
-                with tempfile.TemporaryDirectory() as folder, contextlib.redirect_stdout(io.StringIO()):
-                    if _TSPLIB in args:
-                        path = Path(folder) / "warmup12.tsp"
-                        path.write_text(_WARMUP_TSP)
-                        args = [str(path) if a == _TSPLIB else a for a in args]
-                    code = main(args)
-                if code != 0:
-                    raise HtetroError(f"the warm-up job 'htetro-opt {' '.join(args)}' failed (exit status {code})")
-                if say is not None:
-                    say(f"htetro-opt {' '.join(args)}: done")
+        with tempfile.TemporaryDirectory() as folder:  # the TSPLIB job's file, gone with the folder
+            tsplib = Path(folder) / "warmup12.tsp"
+            tsplib.write_text(_WARMUP_TSP)
+            for part in parts:
+                for args in JOBS[part]:
+                    args = [str(tsplib) if a == _TSPLIB else a for a in args]
+                    with contextlib.redirect_stdout(io.StringIO()):
+                        code = main(args)
+                    if code != 0:
+                        raise HtetroError(f"the warm-up job 'htetro-opt {' '.join(args)}' failed (exit status "
+                                          f"{code})")
+                    if say is not None:
+                        say(f"htetro-opt {' '.join(args)}: done")
     finally:
         _lazy._interpreted_left = left
     compiled = loaded = 0
