@@ -82,6 +82,11 @@ __all__ = ["ILS_KICK_SPAN", "LocalCore", "ils_kicks", "solve_ils"]
 _UNLIMITED = 1 << 62
 """A move budget that never runs out."""
 
+# The kernels pass each other constants as np.int64(...) / np.bool_(...), never bare: numba types a bare
+# constant argument as a literal and compiles the callee once more for it, so that the local search
+# (the longest compile) was built six times a cost kind (nearest lists, 30 waypoints, fresh cache: 31
+# kernel signatures and 22.5 s for ils then local); typed values give every caller the same one.
+
 numba = require_numba()  # the kernels below are compiled at their first call
 from numba.extending import overload  # noqa: E402 - only once numba is known to import
 
@@ -302,10 +307,10 @@ def _lk_move(cm, nbr, nc, tour, pos, log, count, t1, back, depth, eps, touched, 
         level = 0
         if best <= eps:  # no gain yet: a 3-opt move must gain more than eps
             best, level = eps, -1
-        b5 = b6 = -1
+        b5 = b6 = np.int64(-1)
         # level 2 on the tour after the first flip, which reverses S = t2 … t4 (direction s)
         span = ((pos[t4] - pos[t2]) * s) % n
-        p5 = p6 = -1
+        p5 = p6 = np.int64(-1)
         pv = -np.inf
         for j in range(k):
             g2 = g - nc[t4, j]
@@ -352,7 +357,7 @@ def _lk_move(cm, nbr, nc, tour, pos, log, count, t1, back, depth, eps, touched, 
         e = p6
         for lv in range(2, depth):
             fwd = 1 if tour[(pos[t1] + 1) % n] == e else -1
-            pick = pick4 = -1
+            pick = pick4 = np.int64(-1)
             pick_val = -np.inf
             for j in range(k):
                 if g - nc[e, j] <= eps:
@@ -593,11 +598,11 @@ def _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count,
                         fwd = base - _d(cm, s1, x) - _d(cm, s2, y)
                         rev = base - _d(cm, s2, x) - _d(cm, s1, y)
                         if fwd >= rev and fwd > eps:
-                            count = _or_move(tour, pos, log, count, p, s1, s2, nx, x, y, True)
+                            count = _or_move(tour, pos, log, count, p, s1, s2, nx, x, y, np.bool_(True))
                             gain_total += fwd
                             improved = True
                         elif rev > fwd and rev > eps:
-                            count = _or_move(tour, pos, log, count, p, s1, s2, nx, x, y, False)
+                            count = _or_move(tour, pos, log, count, p, s1, s2, nx, x, y, np.bool_(False))
                             gain_total += rev
                             improved = True
                         if improved:
@@ -659,12 +664,13 @@ def _descend(cm, nbr, nc, tour, opt2, lengths, full, eps, budget, halt):
         pos[tour[i]] = i
     queue = np.empty(n, dtype=np.int64)
     queued = np.zeros(n, dtype=np.bool_)
-    size = 0
+    zero = np.int64(0)
+    size = zero
     for i in range(n):
-        size = _push(queue, queued, 0, size, tour[i])
+        size = _push(queue, queued, zero, size, tour[i])
     log = np.empty((0, 4), dtype=np.int64)  # nothing is undone: no move is logged
-    _, _, _, moves = _local_search(cm, nbr, nc, tour, pos, queue, queued, 0, size, log, 0, eps, opt2, lengths,
-                                   full, budget, halt, 0, False)
+    _, _, _, moves = _local_search(cm, nbr, nc, tour, pos, queue, queued, zero, size, log, zero, eps, opt2, lengths,
+                                   full, budget, halt, zero, np.bool_(False))
     return moves
 
 
@@ -687,13 +693,14 @@ def _ils(cm, nbr, tour, kicks, span, seed, eps, halt, lk, or3, worse):
     state[0] = np.uint64(seed)
     nc = _neighbour_costs(cm, nbr)
     lengths = np.arange(1, 4)
-    head = 0
-    size = 0
+    head = np.int64(0)
+    size = np.int64(0)
+    yes, no, unlimited = np.bool_(True), np.bool_(False), np.int64(_UNLIMITED)
     for i in range(n):
         size = _push(queue, queued, head, size, tour[i])
-    _, head, _, _ = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, 0, eps, True, lengths,
-                                  False, _UNLIMITED, halt, lk, or3)
-    size = 0
+    _, head, _, _ = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, np.int64(0), eps, yes,
+                                  lengths, no, unlimited, halt, lk, or3)
+    size = np.int64(0)
     kept = 0
     done = 0
     if n < 8:
@@ -723,7 +730,7 @@ def _ils(cm, nbr, tour, kicks, span, seed, eps, halt, lk, or3, worse):
         d1 = tour[(start + l1 + l2 + 1) % n]
         delta = (_d(cm, a1, c1) + _d(cm, c2, b1) + _d(cm, b2, d1)
                  - _d(cm, a1, b1) - _d(cm, b2, c1) - _d(cm, c2, d1))
-        count = 0
+        count = np.int64(0)
         _two_opt(tour, pos, a1, b1, c2, d1)
         count = _log(log, count, a1, b1, c2, d1)
         _two_opt(tour, pos, a1, c2, c1, b2)
@@ -733,8 +740,8 @@ def _ils(cm, nbr, tour, kicks, span, seed, eps, halt, lk, or3, worse):
         for node in (a1, b1, b2, c1, c2, d1):
             size = _push(queue, queued, head, size, node)
         gain, head, count, _ = _local_search(cm, nbr, nc, tour, pos, queue, queued, head, size, log, count, eps,
-                                             True, lengths, False, _UNLIMITED, halt, lk, or3)
-        size = 0
+                                             yes, lengths, no, unlimited, halt, lk, or3)
+        size = np.int64(0)
         if walk:
             if cur + delta - gain <= best_cost + allowance + eps and count <= log.shape[0]:
                 cur += delta - gain
@@ -836,7 +843,7 @@ def _dense_tree(cm, m, avoid, pi):
     parent = np.full(m, -1, dtype=np.int64)
     done = np.zeros(m, dtype=np.bool_)
     row = np.empty(m)
-    v = 0
+    v = np.int64(0)
     for _ in range(m - 1):
         _row(cm, v, row)
         v = _prim_step(row, v, pi, avoid, key, parent, done)
@@ -855,7 +862,7 @@ def _one_tree(ptr, adj, cost, pi, parent, degree, key, done, hk, hv):
     parent[:] = -1
     degree[:] = 0
     key[0] = 0.0
-    size = _heap_push(hk, hv, 0, 0.0, 0)
+    size = _heap_push(hk, hv, np.int64(0), 0.0, np.int64(0))
     total = 0.0
     while size > 0:
         kv, v, size = _heap_pop(hk, hv, size)
