@@ -32,3 +32,10 @@ def naive_successors(workspace, pose, t, tokens, *, clearance=0.0, timing=Timing
 @pytest.fixture
 def successors():
     return naive_successors
+
+
+def pytest_collection_modifyitems(config, items):
+    """The notebooks first. They are the run's longest items (5-17 s each, collected last), and
+    pytest-xdist's work stealing evens out the two workers' ends only with short items left: a notebook
+    at the end kept the other worker idle for its whole run."""
+    items.sort(key=lambda item: not item.nodeid.startswith("notebooks/"))
