@@ -83,9 +83,8 @@ _UNLIMITED = 1 << 62
 """A move budget that never runs out."""
 
 # The kernels pass each other constants as np.int64(...) / np.bool_(...), never bare: numba types a bare
-# constant argument as a literal and compiles the callee once more for it, so that the local search
-# (the longest compile) was built six times a cost kind (nearest lists, 30 waypoints, fresh cache: 31
-# kernel signatures and 22.5 s for ils then local); typed values give every caller the same one.
+# constant argument as a literal and compiles the callee once more for it (the local search, the longest
+# compile, was built up to six times a cost kind; benchmarks/README.md, "Compiling ahead").
 
 numba = require_numba()  # the kernels below are compiled at their first call
 from numba.extending import overload  # noqa: E402 - only once numba is known to import
