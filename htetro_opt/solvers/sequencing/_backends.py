@@ -42,7 +42,7 @@ from htetro_opt._validation import check_int, check_seed, check_time_limit
 from htetro_opt.errors import ParameterError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance
 from htetro_opt.solvers.sequencing._budgets import default_time_limit
-from htetro_opt.solvers.sequencing._spec import CANDIDATE_LISTS
+from htetro_opt.solvers.sequencing._spec import check_candidates
 
 __all__ = ["FAST_TSP_RESOLUTION", "LKH_RESOLUTION", "solve_fast_tsp", "solve_lkh"]
 
@@ -179,8 +179,7 @@ def solve_fast_tsp(instance: SequencingInstance, *, seed=0, time_limit: float | 
     limit = check_time_limit(time_limit)
     limit = default_time_limit("fast-tsp", instance.n) if limit is None else limit
     threads = check_int(threads, "threads", minimum=1)
-    if candidates not in CANDIDATE_LISTS:
-        raise ParameterError(f"candidates must be one of {', '.join(CANDIDATE_LISTS)}, got {candidates!r}")
+    candidates = check_candidates(candidates, "candidates")
     if not instance.symmetric:
         raise ParameterError("method 'fast-tsp' assumes a symmetric cost matrix, and this one is not: use lkh, "
                              "exact or ortools")

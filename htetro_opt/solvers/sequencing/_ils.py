@@ -72,9 +72,10 @@ from htetro_opt._validation import as_rng, check_bool, check_int, check_real, ch
 from htetro_opt.errors import ParameterError
 from htetro_opt.problems.waypoint_sequencing import SequencingInstance, check_instance, eq2_legs
 from htetro_opt.solvers.sequencing._budgets import default_time_limit
-from htetro_opt.solvers.sequencing._spec import (CANDIDATE_LISTS, ILS_ACCEPT_WORSE, ILS_ALPHA_AUTO, ILS_ALPHA_LIMIT,
+from htetro_opt.solvers.sequencing._spec import (ILS_ACCEPT_WORSE, ILS_ALPHA_AUTO, ILS_ALPHA_LIMIT,
                                                   ILS_ALPHA_PAIR_SECONDS, ILS_ALPHA_TREES, ILS_KICK_RATE,
-                                                  ILS_KICK_SPAN, ILS_LK_DEPTH, ILS_NEIGHBOURS, ILS_OR3OPT)
+                                                  ILS_KICK_SPAN, ILS_LK_DEPTH, ILS_NEIGHBOURS, ILS_OR3OPT,
+                                                  check_candidates)
 
 __all__ = ["ILS_KICK_SPAN", "LocalCore", "ils_kicks", "solve_ils"]
 
@@ -1417,8 +1418,7 @@ def solve_ils(instance, *, seed=0, time_limit: float | None = None, kicks: int |
     kick_span = check_int(kick_span, "kick_span", minimum=1)
     or3opt = check_bool(or3opt, "or3opt")
     neighbours = check_int(neighbours, "neighbours", minimum=1)
-    if candidates not in CANDIDATE_LISTS:
-        raise ParameterError(f"candidates must be one of {', '.join(CANDIDATE_LISTS)}, got {candidates!r}")
+    candidates = check_candidates(candidates, "candidates")
     # auto: alpha where it pays at no risk to the time limit (a rule of the arguments, so reproducible)
     alpha = candidates == "alpha" or (candidates == "auto" and instance.n <= ILS_ALPHA_AUTO
                                       and instance.n ** 2 * ILS_ALPHA_PAIR_SECONDS <= 0.1 * time_limit)

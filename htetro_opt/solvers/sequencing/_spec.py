@@ -22,7 +22,7 @@ from htetro_opt.solvers.tiling._spec import shape_letters  # a scenario is tiled
 __all__ = ["SPEC", "is_tileset", "GA_ADDITIONS", "CANDIDATE_LISTS", "EXACT_AUTO_LIMIT", "EXACT_MAX_SIZE",
            "EXACT_TIME_LIMIT", "FIRST_SOLUTIONS", "ILS_ACCEPT_WORSE", "ILS_ALPHA_AUTO", "ILS_ALPHA_LIMIT",
            "ILS_ALPHA_PAIR_SECONDS", "ILS_ALPHA_TREES", "ILS_KICK_RATE", "ILS_KICK_SPAN", "ILS_LK_DEPTH",
-           "ILS_NEIGHBOURS", "ILS_OR3OPT"]
+           "ILS_NEIGHBOURS", "ILS_OR3OPT", "check_candidates"]
 
 EXACT_AUTO_LIMIT = 40
 """``auto`` proves the optimum with the exact solver up to this many waypoints (a closed tour counts
@@ -113,6 +113,9 @@ CANDIDATE_LISTS = ("auto", "nearest", "alpha")
 cheapest legs; ``alpha``, alpha-nearness (Helsgaun 2000, LKH); ``auto``, the method's own choice (``ils``:
 alpha up to :data:`ILS_ALPHA_AUTO` waypoints within a tenth of the time limit; fast-tsp: its own, see
 :func:`~htetro_opt.solvers.sequencing.solve_fast_tsp`)."""
+
+check_candidates = choice(CANDIDATE_LISTS)
+"""The check of a ``candidates`` value: the option's, and ``ils``'s and fast-tsp's when called directly."""
 
 
 def _label(value, name):
@@ -212,7 +215,7 @@ OPTIONS = (
            default="PATH_CHEAPEST_ARC", flag="", choices=FIRST_SOLUTIONS),
     Option("max_size", integer(1), "largest instance the exact solver accepts", default=EXACT_MAX_SIZE, flag=""),
     Option("threads", integer(1), "fast-tsp's threads", default=1, flag=""),
-    Option("candidates", choice(CANDIDATE_LISTS), "neighbour lists: nearest (the cheapest legs), alpha "
+    Option("candidates", check_candidates, "neighbour lists: nearest (the cheapest legs), alpha "
            "(alpha-nearness, Helsgaun 2000) or auto, the method's own (ils: alpha up to "
            f"{ILS_ALPHA_AUTO} waypoints when they fit a tenth of the time limit, nearest otherwise)", default="auto",
            choices=CANDIDATE_LISTS),
