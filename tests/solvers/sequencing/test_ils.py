@@ -403,26 +403,39 @@ def test_the_default_lists_are_alpha_up_to_their_limit_and_nearest_beyond(monkey
         sequence_waypoints(inst, method="ils", candidates="alpha")
 
 
-def test_the_kernels_are_compiled_for_typed_arguments_only_one_build_a_cost_kind():
+_BUILDS = """
+import json
+import numpy as np
+from numba import types
+from numba.core.registry import CPUDispatcher
+from htetro_opt.problems import SequencingInstance
+from htetro_opt.solvers.sequencing import _ils, sequence_waypoints
+xy = np.random.default_rng(7).random((24, 2)) * 100
+inst = SequencingInstance.from_matrix(np.sqrt(((xy[:, None] - xy[None]) ** 2).sum(-1)), closed=True, start=0)
+for options in ({"candidates": "nearest"}, {"candidates": "alpha"}):
+    sequence_waypoints(inst, method="ils", seed=0, kicks=50, **options)
+sequence_waypoints(inst, method="local", seed=0)
+print(json.dumps({name: [[str(t) for t in signature] for signature in k.signatures]
+                  for name, k in vars(_ils).items() if isinstance(k, CPUDispatcher)}))
+"""
+
+
+def test_the_kernels_are_compiled_for_typed_arguments_only_one_build_a_cost_kind(tmp_path):
     """numba compiles a kernel once more for every literal constant it is passed (a bare ``0`` or ``True``
-    from another kernel): the ILS, its LK and segment-exchange moves, the alpha lists and ``local``'s
-    descent all pass typed values, so each kernel has one build for dense matrix costs, and none is a
-    literal specialisation (the worker's other tests may add builds for the other cost kinds)."""
-    from numba import types
-    from numba.core.registry import CPUDispatcher
+    from another kernel): the ILS, its moves, the alpha lists and ``local``'s descent all pass typed values,
+    so that on dense matrix costs every kernel is built once and none for a literal. In a fresh process and
+    a fresh numba cache: a kernel loaded from the cache lists only what its callers were loaded with."""
+    import json
+    import os
+    import subprocess
+    import sys
 
-    from htetro_opt.solvers.sequencing import _ils
-
-    inst = SequencingInstance.from_matrix(euclidean(24, 7), closed=True, start=0)
-    for options in ({"candidates": "nearest"}, {"candidates": "alpha"},
-                    {"candidates": "nearest", "lk_depth": 3, "or3opt": True}):
-        sequence_waypoints(inst, method="ils", seed=0, kicks=50, **options)
-    sequence_waypoints(inst, method="local", seed=0)
-    dense = types.Array(types.float64, 2, "C")
-    kernels = {name: k for name, k in vars(_ils).items() if isinstance(k, CPUDispatcher)}
-    assert {"_ils", "_local_search", "_lk_move", "_or3_move", "_or_move", "_descend", "_alpha_lists"} <= set(kernels)
-    for name, kernel in kernels.items():
-        for signature in kernel.signatures:
-            assert not any(isinstance(t, types.Literal) for t in signature), (name, signature)
-    for name in ("_ils", "_local_search", "_lk_move", "_or3_move", "_descend", "_alpha_lists", "_dense_tree"):
-        assert sum(s[0] == dense for s in kernels[name].signatures) == 1, (name, kernels[name].signatures)
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    run = subprocess.run([sys.executable, "-c", _BUILDS], capture_output=True, text=True, check=True, env=env,
+                         timeout=600)
+    builds = json.loads(run.stdout.strip().splitlines()[-1])
+    assert {"_ils", "_local_search", "_lk_move", "_or3_move", "_or_move", "_descend", "_alpha_lists"} <= set(builds)
+    for name, signatures in builds.items():
+        assert not any("Literal" in t for signature in signatures for t in signature), (name, signatures)
+        assert len(signatures) <= 1, (name, signatures)  # one cost kind here: one build each
+    assert all(len(builds[name]) == 1 for name in ("_ils", "_local_search", "_lk_move", "_descend", "_alpha_lists"))
